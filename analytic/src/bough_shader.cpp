@@ -1,0 +1,141 @@
+#include "pine/analytic/bough_shader.h"
+
+#include "pine/analytic/quadrature.h"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pine::analytic {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// rate x length, where a zero length crosses no layer even at an infinite rate.
+double layers(double rate, double length) { return length > 0.0 ? rate * length : 0.0; }
+
+// Gauss-Legendre on [a, b] in two panels: 16 nodes.
+template <class F>
+double gl16(F&& f, double a, double b)
+{
+    const double m = 0.5 * (a + b);
+    return gaussLegendre8(f, a, m) + gaussLegendre8(f, m, b);
+}
+
+}  // namespace
+
+double layerRate(double aperture_rad, double c, double s)
+{
+    const double sinPhi = std::sin(aperture_rad);
+    if (!(s > 0.0) || !(sinPhi > 0.0)) return kInf;
+    return std::abs(std::cos(aperture_rad) * s - sinPhi * c) / (sinPhi * s);
+}
+
+double layerRateMirror(double aperture_rad, double c, double s)
+{
+    return layerRate(aperture_rad, -c, s);
+}
+
+BoughView boughView(double aperture_rad, const Vec3& axis, const Vec3& L, const Vec3& V)
+{
+    const AxisProjection v = projectOnAxis(axis, V), l = projectOnAxis(axis, L);
+    BoughView b;
+    b.kV = layerRate(aperture_rad, v.c, v.s);
+    b.kVbar = layerRateMirror(aperture_rad, v.c, v.s);
+    b.kL = layerRate(aperture_rad, l.c, l.s);
+    b.kLbar = layerRateMirror(aperture_rad, l.c, l.s);
+    // l_v is undefined when L or V runs along the branch; cos = 0 is its mean over azimuths.
+    b.cosLV = (v.s > 1e-9 && l.s > 1e-9) ? std::cos(angleBetween(l.perp, v.perp)) : 0.0;
+    return b;
+}
+
+BoughLinearLaw boughLinearLaw(const BoughGeometry& bough, const BoughView& view)
+{
+    BoughLinearLaw law;
+    const double A = layerOpacity(bough.cone), R = boughRadius(bough.cone);
+    if (!(A * R > 0.0)) return law;  // no needles or no volume: transparent
+    law.a = 0.25 * kPi * A * R / bough.coneSpacing_cm;
+    law.alphaUnclamped = law.a * (view.kV + view.kVbar);
+
+    // The front half hides the rear: alpha_F + alpha_R <= 1 keeps the total a coverage.
+    const auto clampPair = [&](double k, double kbar) {
+        const double front = std::min(1.0, law.a * k);
+        return FrontRear{front, std::clamp(law.a * kbar, 0.0, 1.0 - front)};
+    };
+    law.alphaView = clampPair(view.kV, view.kVbar);
+    law.alphaLight = clampPair(view.kL, view.kLbar);
+
+    const double c = view.cosLV, s = 8.0 / (3.0 * kPi * kPi);
+    const double fv = law.alphaView.front, rv = law.alphaView.rear;
+    const double fl = law.alphaLight.front, rl = law.alphaLight.rear;
+    law.transfer.front =
+        fv * std::clamp(1.0 - s * (2.0 * fv + (1.0 - c) * rl + (3.0 - c) * fl), 0.0, 1.0);
+    law.transfer.rear =
+        rv * std::clamp(1.0 - s * (4.0 * fv + 2.0 * rv + (1.0 + c) * rl + (3.0 + c) * fl), 0.0, 1.0);
+    return law;
+}
+
+BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool shadows)
+{
+    BoughExact out;
+    const double A = layerOpacity(bough.cone), R = boughRadius(bough.cone);
+    if (!(A * R > 0.0)) return out;
+    const double mu = -std::log1p(-A);  // optical depth of one layer; +inf when A = 1
+    const double scale = R / bough.coneSpacing_cm;
+    // Layers per unit of normalised projected length (unit disk) for each half and ray.
+    const double nuV = layers(view.kV, scale), nuVbar = layers(view.kVbar, scale);
+    const double nuL = layers(view.kL, scale), nuLbar = layers(view.kLbar, scale);
+    const auto transmittance = [&](double n) { return n > 0.0 ? std::exp(-mu * n) : 1.0; };
+
+    // Unit-disk frame: zeta along V_p (towards the viewer), xi across; e_l at angle l_v.
+    const double cl = view.cosLV, sl = std::sqrt(std::max(0.0, 1.0 - cl * cl));
+    const auto shadowTransmittance = [&](double zeta, double xi) {
+        if (!shadows) return 1.0;
+        const double u = zeta * cl + xi * sl;   // along L_p, towards the light
+        const double w = -zeta * sl + xi * cl;  // across L_p
+        const double half = std::sqrt(std::max(0.0, 1.0 - w * w));
+        const double n = u >= 0.0 ? layers(nuL, half - u)
+                                  : layers(nuL, half) + layers(nuLbar, -u);
+        return transmittance(n);
+    };
+    // A chord at offset xi = sin(t) has half-length rho = cos(t); dxi = cos(t) dt.
+    // Along its front half, with optical depth s = mu nuV (rho - zeta) from the entry,
+    // tau = 1 - exp(-s) runs over [0, 1 - T^(nuV rho)] and d tau = mu nuV T^(...) dzeta.
+    const auto zetaAt = [&](double tau, double nu) {
+        const double depth = -std::log1p(-tau) / mu;  // layers crossed
+        return std::isinf(nu) ? 0.0 : depth / nu;
+    };
+    const auto chord = [&](double t, bool wantAlpha, bool rear) {
+        const double xi = std::sin(t), rho = std::cos(t);
+        const double frontAlpha = 1.0 - transmittance(layers(nuV, rho));
+        const double rearAlpha = 1.0 - transmittance(layers(nuVbar, rho));
+        double value;
+        if (wantAlpha) {
+            value = rear ? (1.0 - frontAlpha) * rearAlpha : frontAlpha;
+        } else if (!rear) {
+            value = frontAlpha <= 0.0 ? 0.0 : gl16([&](double tau) {
+                return shadowTransmittance(rho - zetaAt(tau, nuV), xi);
+            }, 0.0, frontAlpha);
+        } else {
+            value = rearAlpha <= 0.0 ? 0.0 : (1.0 - frontAlpha) * gl16([&](double tau) {
+                return shadowTransmittance(-zetaAt(tau, nuVbar), xi);
+            }, 0.0, rearAlpha);
+        }
+        return 0.5 * value * rho;  // the mean over xi in [-1, 1] is half the integral
+    };
+    constexpr double kHalfPi = 0.5 * kPi;
+    out.alpha.front = gl16([&](double t) { return chord(t, true, false); }, -kHalfPi, kHalfPi);
+    out.alpha.rear = gl16([&](double t) { return chord(t, true, true); }, -kHalfPi, kHalfPi);
+    out.transfer.front = gl16([&](double t) { return chord(t, false, false); }, -kHalfPi, kHalfPi);
+    out.transfer.rear = gl16([&](double t) { return chord(t, false, true); }, -kHalfPi, kHalfPi);
+    return out;
+}
+
+SweptAreas sweptAreas(double c)
+{
+    return {1.0 - c / 3.0, (1.0 - c) / 3.0, 1.0 + c / 3.0, (1.0 + c) / 3.0};
+}
+
+}  // namespace pine::analytic
