@@ -47,7 +47,7 @@ double productIntegral(const Harmonic& l, const Harmonic& v, double sign)
 // lobe's tail near psi_e still counts when n is moderate. So instead of Laplace's closed form
 // we integrate the exact integrand by Gauss-Legendre on windows of +-6 such widths placed
 // where Laplace's analysis puts the peaks, split at the faces' edges: correct in all regimes,
-// and O(1) in n.
+// and O(1) in n: at most 2 windows x 4 panels x 8 nodes.
 std::pair<double, double> specularFaceIntegrals(const Harmonic& hv,
                                                 const Harmonic& hh, const Vec3& H, const Vec3& V,
                                                 double exponent)
@@ -63,14 +63,18 @@ std::pair<double, double> specularFaceIntegrals(const Harmonic& hv,
     const double psiE = hh.u < 0.0 ? 0.0 : kPi;
     const double quartic = std::pow(8.0 / (kappa * w * w), 0.25);
     std::vector<std::pair<double, double>> windows;  // in psi, relative to psi_e
+    double sigmaOf = quartic;                        // the peaks' width
     if (gap <= 0.0) {
         const double delta = std::acos(std::min(1.0, absU / w));
         const double sigma = std::min(quartic, 1.0 / (std::sqrt((w - absU) * (w + absU) * kappa)));
-        windows = {{-delta - 6.0 * sigma, -delta + 6.0 * sigma},
-                   {delta - 6.0 * sigma, delta + 6.0 * sigma}};
-        if (windows[0].second >= windows[1].first) windows = {{windows[0].first, windows[1].second}};
+        sigmaOf = sigma;
+        // One window per peak, meeting at the extremum between them where they overlap: a
+        // merged window would hold two narrow peaks too few nodes apart.
+        windows = {{-delta - 6.0 * sigma, std::min(-delta + 6.0 * sigma, 0.0)},
+                   {std::max(delta - 6.0 * sigma, 0.0), delta + 6.0 * sigma}};
     } else {
         const double sigma = std::min(quartic, 1.0 / std::sqrt(kappa * gap * w));
+        sigmaOf = sigma;
         windows = {{-6.0 * sigma, 6.0 * sigma}};
     }
     const double VH = glm::dot(V, H);
@@ -92,8 +96,13 @@ std::pair<double, double> specularFaceIntegrals(const Harmonic& hv,
         }
         cuts.push_back(to);
         for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
-            const double piece = gaussLegendre8(lobe, cuts[i], 0.5 * (cuts[i] + cuts[i + 1])) +
-                                 gaussLegendre8(lobe, 0.5 * (cuts[i] + cuts[i + 1]), cuts[i + 1]);
+            // Panels at most 3 peak widths wide (4 over a whole window): 8 nodes each.
+            const int panels = std::clamp(int(std::ceil((cuts[i + 1] - cuts[i]) / (3.0 * sigmaOf))), 1, 4);
+            double piece = 0.0;
+            for (int k = 0; k < panels; ++k) {
+                const double h = (cuts[i + 1] - cuts[i]) / panels;
+                piece += gaussLegendre8(lobe, cuts[i] + k * h, cuts[i] + (k + 1) * h);
+            }
             const double mid = std::remainder(0.5 * (cuts[i] + cuts[i + 1]), 2.0 * kPi);
             (std::abs(mid) <= kHalfPi ? front : rear) += piece;
         }

@@ -53,7 +53,7 @@ struct ConeIntegrals {
 ///  - S: the lobe peaks at the azimuths where the needle is orthogonal to H (the paper's idea,
 ///    eq. 5). Laplace's method there needs the Jacobian 1 / |dc_h/dtheta| the paper drops, and
 ///    fails where the two peaks merge or where no needle is orthogonal to H but n is moderate.
-///    We integrate the exact integrand by 16-point Gauss-Legendre on windows placed and sized
+///    We integrate the exact integrand by Gauss-Legendre (<= 64 nodes) on windows placed and sized
 ///    by that analysis: a cost independent of n, relative error < 1e-3 (tests).
 /// @param axis  unit branch direction; L, V unit; exponent n > 1.
 ConeIntegrals coneIntegrals(double aperture_rad, const Vec3& axis, const Vec3& L,
