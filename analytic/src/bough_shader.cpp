@@ -67,13 +67,19 @@ BoughLinearLaw boughLinearLaw(const BoughGeometry& bough, const BoughView& view)
     law.alphaView = clampPair(view.kV, view.kVbar);
     law.alphaLight = clampPair(view.kL, view.kLbar);
 
+    // Section 6.6, with k-bar_V in the rear terms where sections 6.4-6.5 print k_V.
     const double c = view.cosLV, s = 8.0 / (3.0 * kPi * kPi);
-    const double fv = law.alphaView.front, rv = law.alphaView.rear;
-    const double fl = law.alphaLight.front, rl = law.alphaLight.rear;
-    law.transfer.front =
-        fv * std::clamp(1.0 - s * (2.0 * fv + (1.0 - c) * rl + (3.0 - c) * fl), 0.0, 1.0);
-    law.transfer.rear =
-        rv * std::clamp(1.0 - s * (4.0 * fv + 2.0 * rv + (1.0 + c) * rl + (3.0 + c) * fl), 0.0, 1.0);
+    const auto brackets = [&](double fv, double rv, double fl, double rl) {
+        return FrontRear{1.0 - s * (2.0 * fv + (1.0 - c) * rl + (3.0 - c) * fl),
+                         1.0 - s * (4.0 * fv + 2.0 * rv + (1.0 + c) * rl + (3.0 + c) * fl)};
+    };
+    const FrontRear& v = law.alphaView;
+    const FrontRear& l = law.alphaLight;
+    const FrontRear kept = brackets(v.front, v.rear, l.front, l.rear);
+    law.transfer = {v.front * std::clamp(kept.front, 0.0, 1.0), v.rear * std::clamp(kept.rear, 0.0, 1.0)};
+    const double fv = law.a * view.kV, rv = law.a * view.kVbar;
+    const FrontRear raw = brackets(fv, rv, law.a * view.kL, law.a * view.kLbar);
+    law.transferUnclamped = {fv * raw.front, rv * raw.rear};
     return law;
 }
 
@@ -107,29 +113,48 @@ BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool sh
         const double depth = -std::log1p(-tau) / mu;  // layers crossed
         return std::isinf(nu) ? 0.0 : depth / nu;
     };
+    // The shadow chord changes halves (a kink in T_L) where u = 0: zeta = -xi sin / cos(l_v).
+    // Gauss-Legendre is split there, mapped to tau.
+    const auto tauOf = [&](double depthFromEntry, double nu) {
+        return 1.0 - transmittance(layers(nu, depthFromEntry));
+    };
+    const auto splitAt = [&](auto&& f, double end, double kinkTau) {
+        if (kinkTau > 0.0 && kinkTau < end) return gl16(f, 0.0, kinkTau) + gl16(f, kinkTau, end);
+        return gl16(f, 0.0, end);
+    };
     const auto chord = [&](double t, bool wantAlpha, bool rear) {
         const double xi = std::sin(t), rho = std::cos(t);
         const double frontAlpha = 1.0 - transmittance(layers(nuV, rho));
         const double rearAlpha = 1.0 - transmittance(layers(nuVbar, rho));
+        const double kink = std::abs(cl) > 1e-12 ? -xi * sl / cl : 2.0;  // outside if none
         double value;
         if (wantAlpha) {
             value = rear ? (1.0 - frontAlpha) * rearAlpha : frontAlpha;
         } else if (!rear) {
-            value = frontAlpha <= 0.0 ? 0.0 : gl16([&](double tau) {
+            const double kinkTau = kink > 0.0 && kink < rho ? tauOf(rho - kink, nuV) : -1.0;
+            value = frontAlpha <= 0.0 ? 0.0 : splitAt([&](double tau) {
                 return shadowTransmittance(rho - zetaAt(tau, nuV), xi);
-            }, 0.0, frontAlpha);
+            }, frontAlpha, kinkTau);
         } else {
-            value = rearAlpha <= 0.0 ? 0.0 : (1.0 - frontAlpha) * gl16([&](double tau) {
+            const double kinkTau = kink < 0.0 && kink > -rho ? tauOf(-kink, nuVbar) : -1.0;
+            value = rearAlpha <= 0.0 ? 0.0 : (1.0 - frontAlpha) * splitAt([&](double tau) {
                 return shadowTransmittance(-zetaAt(tau, nuVbar), xi);
-            }, 0.0, rearAlpha);
+            }, rearAlpha, kinkTau);
         }
         return 0.5 * value * rho;  // the mean over xi in [-1, 1] is half the integral
     };
     constexpr double kHalfPi = 0.5 * kPi;
     out.alpha.front = gl16([&](double t) { return chord(t, true, false); }, -kHalfPi, kHalfPi);
     out.alpha.rear = gl16([&](double t) { return chord(t, true, true); }, -kHalfPi, kHalfPi);
-    out.transfer.front = gl16([&](double t) { return chord(t, false, false); }, -kHalfPi, kHalfPi);
-    out.transfer.rear = gl16([&](double t) { return chord(t, false, true); }, -kHalfPi, kHalfPi);
+    // Over the chords, the kink line enters or leaves a half-chord at xi = 0 and xi = +-|cos l_v|:
+    // split there too.
+    const double edge = std::asin(std::min(1.0, std::abs(cl)));
+    const double cuts[] = {-kHalfPi, -edge, 0.0, edge, kHalfPi};
+    for (int i = 0; i < 4; ++i) {
+        if (cuts[i + 1] <= cuts[i]) continue;
+        out.transfer.front += gaussLegendre8([&](double t) { return chord(t, false, false); }, cuts[i], cuts[i + 1]);
+        out.transfer.rear += gaussLegendre8([&](double t) { return chord(t, false, true); }, cuts[i], cuts[i + 1]);
+    }
     return out;
 }
 

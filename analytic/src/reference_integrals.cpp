@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace pine::analytic::reference {
 namespace {
@@ -35,6 +36,44 @@ double circleIntegral(const std::function<double(double)>& f, double from, doubl
 }
 
 double positive(double x) { return x > 0.0 ? x : 0.0; }
+
+// The unit cross-section disk, in the frame of the view: zeta along V_p (towards the viewer),
+// xi across it; L_p at angle l_v from V_p. A shadow chord from (zeta, xi) runs along L_p.
+struct DiskFrame {
+    double cl, sl;  // cos and sin of l_v
+    explicit DiskFrame(double cosLV)
+        : cl(cosLV), sl(std::sqrt(std::max(0.0, 1.0 - cosLV * cosLV))) {}
+    double along(double zeta, double xi) const { return zeta * cl + xi * sl; }    // u
+    double across(double zeta, double xi) const { return -zeta * sl + xi * cl; }  // w
+    /// Shadow-chord lengths from (zeta, xi) within the light's front and rear halves.
+    std::pair<double, double> shadowLengths(double zeta, double xi) const
+    {
+        const double u = along(zeta, xi), w = across(zeta, xi);
+        const double half = std::sqrt(std::max(0.0, 1.0 - w * w));
+        return u >= 0.0 ? std::pair{half - u, 0.0} : std::pair{half, -u};
+    }
+    /// The zeta on chord xi where the shadow chord changes halves (u = 0): a kink.
+    double kink(double xi) const { return std::abs(cl) > 1e-12 ? -xi * sl / cl : 2.0; }
+};
+
+double halfChordRho(double xi) { return std::sqrt(std::max(0.0, 1.0 - xi * xi)); }
+
+// Integral over the view's front (zeta in [0, rho]) or rear half of chord xi, split at the
+// shadow kink when it falls inside.
+double overHalfChord(const std::function<double(double)>& f, const DiskFrame& disk, double xi,
+                     bool front, double absTol)
+{
+    const double rho = halfChordRho(xi);
+    const double a = front ? 0.0 : -rho, b = front ? rho : 0.0, k = disk.kink(xi);
+    if (k > a && k < b) return integrateAdaptive(f, a, k, absTol) + integrateAdaptive(f, k, b, absTol);
+    return integrateAdaptive(f, a, b, absTol);
+}
+
+// Layers crossed by the view ray from its entry to (zeta, on a chord of half-length rho).
+double viewLayers(double zeta, double rho, double nuV, double nuVbar)
+{
+    return zeta >= 0.0 ? nuV * (rho - zeta) : nuV * rho + nuVbar * (-zeta);
+}
 
 }  // namespace
 
@@ -117,82 +156,75 @@ BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool sh
     const double scale = R / bough.coneSpacing_cm;
     const double nuV = view.kV * scale, nuVbar = view.kVbar * scale;
     const double nuL = view.kL * scale, nuLbar = view.kLbar * scale;
-    const double cl = view.cosLV, sl = std::sqrt(std::max(0.0, 1.0 - cl * cl));
-
-    // Layers crossed from (zeta, xi) to the light, straight from the definition: walk the
-    // shadow chord's light half and, if inside, its far half.
-    const auto shadowLayers = [&](double zeta, double xi) {
-        if (!shadows) return 0.0;
-        const double u = zeta * cl + xi * sl, w = -zeta * sl + xi * cl;
-        const double half = std::sqrt(std::max(0.0, 1.0 - w * w));
-        return u >= 0.0 ? nuL * (half - u) : nuL * half + nuLbar * (-u);
-    };
-    const auto viewLayers = [&](double zeta, double rho) {
-        return zeta >= 0.0 ? nuV * (rho - zeta) : nuV * rho + nuVbar * (-zeta);
-    };
+    const DiskFrame disk(view.cosLV);
     const auto overXi = [&](const std::function<double(double)>& perChord) {
         return 0.5 * integrateAdaptive(perChord, -1.0, 1.0, 1e-11, 1e-9);
     };
-    const auto overZeta = [&](const std::function<double(double)>& f, double a, double b,
-                              double split) {
-        // Split where the shadow chord changes halves (a kink) if it falls inside.
-        if (split > a && split < b) {
-            return integrateAdaptive(f, a, split, 1e-12, 1e-10) +
-                   integrateAdaptive(f, split, b, 1e-12, 1e-10);
-        }
-        return integrateAdaptive(f, a, b, 1e-12, 1e-10);
-    };
     out.alpha.front = overXi([&](double xi) {
-        const double rho = std::sqrt(std::max(0.0, 1.0 - xi * xi));
-        return 1.0 - std::exp(-mu * nuV * rho);
+        return 1.0 - std::exp(-mu * nuV * halfChordRho(xi));
     });
     out.alpha.rear = overXi([&](double xi) {
-        const double rho = std::sqrt(std::max(0.0, 1.0 - xi * xi));
+        const double rho = halfChordRho(xi);
         return std::exp(-mu * nuV * rho) * (1.0 - std::exp(-mu * nuVbar * rho));
     });
     for (const bool front : {true, false}) {
         const double density = mu * (front ? nuV : nuVbar);  // emission per unit length
         (front ? out.transfer.front : out.transfer.rear) = overXi([&](double xi) {
-            const double rho = std::sqrt(std::max(0.0, 1.0 - xi * xi));
-            const double split = std::abs(cl) > 1e-12 ? -xi * sl / cl : 2.0;
+            const double rho = halfChordRho(xi);
             const auto f = [&](double zeta) {
-                return density * std::exp(-mu * (viewLayers(zeta, rho) + shadowLayers(zeta, xi)));
+                const auto [inFront, inRear] = disk.shadowLengths(zeta, xi);
+                const double nL = shadows ? nuL * inFront + nuLbar * inRear : 0.0;
+                return density * std::exp(-mu * (viewLayers(zeta, rho, nuV, nuVbar) + nL));
             };
-            return front ? overZeta(f, 0.0, rho, split) : overZeta(f, -rho, 0.0, split);
+            return overHalfChord(f, disk, xi, front, 1e-12);
         });
+    }
+    return out;
+}
+
+FrontRear boughLinearized(const BoughGeometry& bough, const BoughView& view)
+{
+    const double A = layerOpacity(bough.cone), R = boughRadius(bough.cone);
+    if (!(A * R > 0.0)) return {};
+    const double scale = R / bough.coneSpacing_cm;
+    const double nuV = view.kV * scale, nuVbar = view.kVbar * scale;
+    const double nuL = view.kL * scale, nuLbar = view.kLbar * scale;
+    const DiskFrame disk(view.cosLV);
+    FrontRear out;
+    for (const bool front : {true, false}) {
+        // Emission A per layer crossed, nu layers per unit length: A nu per unit length; the
+        // mean over the chords' offsets xi in [-1, 1] is half the integral.
+        const double density = A * (front ? nuV : nuVbar);
+        (front ? out.front : out.rear) = 0.5 * integrateAdaptive(
+            [&](double xi) {
+                const double rho = halfChordRho(xi);
+                const auto f = [&](double zeta) {
+                    const auto [inFront, inRear] = disk.shadowLengths(zeta, xi);
+                    const double nL = nuL * inFront + nuLbar * inRear;
+                    return density * (1.0 - A * viewLayers(zeta, rho, nuV, nuVbar) - A * nL);
+                };
+                return overHalfChord(f, disk, xi, front, 1e-13);
+            },
+            -1.0, 1.0, 1e-12);
     }
     return out;
 }
 
 SweptAreas sweptAreas(double cosLV)
 {
-    const double cl = cosLV, sl = std::sqrt(std::max(0.0, 1.0 - cl * cl));
-    // Shadow-chord lengths within the light's front (u > 0 side) and rear halves.
-    const auto inFront = [&](double zeta, double xi) {
-        const double u = zeta * cl + xi * sl, w = -zeta * sl + xi * cl;
-        const double half = std::sqrt(std::max(0.0, 1.0 - w * w));
-        return u >= 0.0 ? half - u : half;
-    };
-    const auto inRear = [&](double zeta, double xi) {
-        const double u = zeta * cl + xi * sl;
-        return u >= 0.0 ? 0.0 : -u;
-    };
-    const auto region = [&](auto length, bool viewFront) {
+    const DiskFrame disk(cosLV);
+    const auto region = [&](bool lightFront, bool viewFront) {
         return integrateAdaptive(
             [&](double xi) {
-                const double rho = std::sqrt(std::max(0.0, 1.0 - xi * xi));
-                const double a = viewFront ? 0.0 : -rho, b = viewFront ? rho : 0.0;
-                const double split = std::abs(cl) > 1e-12 ? -xi * sl / cl : 2.0;
-                const auto f = [&](double zeta) { return length(zeta, xi); };
-                if (split > a && split < b) {
-                    return integrateAdaptive(f, a, split, 1e-13) + integrateAdaptive(f, split, b, 1e-13);
-                }
-                return integrateAdaptive(f, a, b, 1e-13);
+                const auto f = [&](double zeta) {
+                    const auto lengths = disk.shadowLengths(zeta, xi);
+                    return lightFront ? lengths.first : lengths.second;
+                };
+                return overHalfChord(f, disk, xi, viewFront, 1e-13);
             },
             -1.0, 1.0, 1e-11);
     };
-    return {region(inFront, true), region(inRear, true), region(inFront, false),
-            region(inRear, false)};
+    return {region(true, true), region(false, true), region(true, false), region(false, false)};
 }
 
 }  // namespace pine::analytic::reference

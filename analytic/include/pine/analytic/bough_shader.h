@@ -44,6 +44,9 @@ struct BoughLinearLaw {
     FrontRear alphaLight;  ///< alpha_FL, alpha_RL, clamped likewise
     /// I_FV / I^cyl_front and I_RV / I^cyl_rear of section 6.6, each bracket kept in [0, 1].
     FrontRear transfer;
+    /// The same from the unclamped alphas and brackets: the formula exactly as derived, which
+    /// can exceed 1 or go negative when n A is not small.
+    FrontRear transferUnclamped;
 };
 BoughLinearLaw boughLinearLaw(const BoughGeometry& bough, const BoughView& view);
 

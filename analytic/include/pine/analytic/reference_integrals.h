@@ -31,6 +31,11 @@ double coneLambdaFitIntegral(double aperture_rad, const Vec3& axis, const Vec3& 
 /// depth. Needs finite layer rates (no ray along the branch).
 BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool shadows = true);
 
+/// Equation (7) under the linear law, before any closed-form step: the transfer of each half,
+/// (A / (2 R dh)) int k (1 - A n_V - A n_L) over the half disk, by quadrature. Section 6.6's
+/// formula (BoughLinearLaw::transferUnclamped) must equal it. Needs finite layer rates.
+FrontRear boughLinearized(const BoughGeometry& bough, const BoughView& view);
+
 /// The swept-area integrals of section 6.5 on the unit disk, by nested adaptive quadrature.
 SweptAreas sweptAreas(double cosLV);
 
