@@ -16,12 +16,14 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // rate x length, where a zero length crosses no layer even at an infinite rate.
 double layers(double rate, double length) { return length > 0.0 ? rate * length : 0.0; }
 
-// Gauss-Legendre on [a, b] in two panels: 16 nodes.
+// Gauss-Legendre on [a, b] in `panels` equal panels of 8 nodes.
 template <class F>
-double gl16(F&& f, double a, double b)
+double glPanels(F&& f, double a, double b, int panels)
 {
-    const double m = 0.5 * (a + b);
-    return gaussLegendre8(f, a, m) + gaussLegendre8(f, m, b);
+    double sum = 0.0;
+    const double h = (b - a) / panels;
+    for (int i = 0; i < panels; ++i) sum += gaussLegendre8(f, a + i * h, a + (i + 1) * h);
+    return sum;
 }
 
 }  // namespace
@@ -94,6 +96,12 @@ BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool sh
     const double nuV = layers(view.kV, scale), nuVbar = layers(view.kVbar, scale);
     const double nuL = layers(view.kL, scale), nuLbar = layers(view.kLbar, scale);
     const auto transmittance = [&](double n) { return n > 0.0 ? std::exp(-mu * n) : 1.0; };
+    // Where the bough is dense, only a skin of optical depth ~1 is lit or seen: its thickness,
+    // 1 / (mu nu) of the radius, sets how finely the rule must sample (2 to 8 panels of 8
+    // nodes on each piece).
+    const double sharpness = A < 1.0 ? mu * std::max({nuV, nuVbar, shadows ? nuL : 0.0,
+                                                      shadows ? nuLbar : 0.0}) : 0.0;
+    const int panels = std::isfinite(sharpness) ? std::clamp(int(std::ceil(sharpness / 6.0)), 2, 8) : 8;
 
     // Unit-disk frame: zeta along V_p (towards the viewer), xi across; e_l at angle l_v.
     const double cl = view.cosLV, sl = std::sqrt(std::max(0.0, 1.0 - cl * cl));
@@ -119,8 +127,10 @@ BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool sh
         return 1.0 - transmittance(layers(nu, depthFromEntry));
     };
     const auto splitAt = [&](auto&& f, double end, double kinkTau) {
-        if (kinkTau > 0.0 && kinkTau < end) return gl16(f, 0.0, kinkTau) + gl16(f, kinkTau, end);
-        return gl16(f, 0.0, end);
+        if (kinkTau > 0.0 && kinkTau < end) {
+            return glPanels(f, 0.0, kinkTau, panels) + glPanels(f, kinkTau, end, panels);
+        }
+        return glPanels(f, 0.0, end, panels);
     };
     const auto chord = [&](double t, bool wantAlpha, bool rear) {
         const double xi = std::sin(t), rho = std::cos(t);
@@ -143,18 +153,24 @@ BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool sh
         }
         return 0.5 * value * rho;  // the mean over xi in [-1, 1] is half the integral
     };
+    // One rule over the chords for all four, so that without shadows each transfer equals its
+    // opacity to the last digit. The kink line enters or leaves a half chord at xi = 0 and
+    // xi = +-|cos l_v|: the rule is split there.
     constexpr double kHalfPi = 0.5 * kPi;
-    out.alpha.front = gl16([&](double t) { return chord(t, true, false); }, -kHalfPi, kHalfPi);
-    out.alpha.rear = gl16([&](double t) { return chord(t, true, true); }, -kHalfPi, kHalfPi);
-    // Over the chords, the kink line enters or leaves a half-chord at xi = 0 and xi = +-|cos l_v|:
-    // split there too.
     const double edge = std::asin(std::min(1.0, std::abs(cl)));
     const double cuts[] = {-kHalfPi, -edge, 0.0, edge, kHalfPi};
-    for (int i = 0; i < 4; ++i) {
-        if (cuts[i + 1] <= cuts[i]) continue;
-        out.transfer.front += gaussLegendre8([&](double t) { return chord(t, false, false); }, cuts[i], cuts[i + 1]);
-        out.transfer.rear += gaussLegendre8([&](double t) { return chord(t, false, true); }, cuts[i], cuts[i + 1]);
-    }
+    const auto overChords = [&](bool wantAlpha, bool rear) {
+        double sum = 0.0;
+        for (int i = 0; i < 4; ++i) {
+            if (cuts[i + 1] > cuts[i]) {
+                sum += glPanels([&](double t) { return chord(t, wantAlpha, rear); }, cuts[i],
+                                cuts[i + 1], panels);
+            }
+        }
+        return sum;
+    };
+    out.alpha = {overChords(true, false), overChords(true, true)};
+    out.transfer = {overChords(false, false), overChords(false, true)};
     return out;
 }
 

@@ -1,5 +1,6 @@
 #include "pine/analytic/quadrature.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -60,6 +61,17 @@ double integrateAdaptive(const std::function<double(double)>& f, double a, doubl
     // A first estimate sets the scale of the relative tolerance.
     const double tol = std::max(absTol, relTol * std::abs(whole.value));
     return recurse(f, a, b, whole, tol, maxDepth);
+}
+
+double integrateAdaptive(const std::function<double(double)>& f, std::vector<double> points,
+                         double absTol, double relTol)
+{
+    std::sort(points.begin(), points.end());
+    double sum = 0.0;
+    for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+        if (points[i + 1] > points[i]) sum += integrateAdaptive(f, points[i], points[i + 1], absTol, relTol);
+    }
+    return sum;
 }
 
 }  // namespace pine::analytic

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 namespace pine::analytic::reference {
 namespace {
@@ -20,19 +21,25 @@ struct CylinderNormals {
     explicit CylinderNormals(const Vec3& axis)
         : e1(anyPerpendicular(axis)), e2(glm::cross(axis, e1)) {}
     Vec3 at(double alpha) const { return std::cos(alpha) * e1 + std::sin(alpha) * e2; }
+    /// The two angles in [0, 2 pi) where N . X = 0: the kinks of (N . X)+.
+    std::vector<double> terminator(const Vec3& X) const
+    {
+        const double a = std::atan2(glm::dot(X, e2), glm::dot(X, e1));
+        return {std::fmod(a + 2.5 * kPi, 2 * kPi), std::fmod(a + 3.5 * kPi, 2 * kPi)};
+    }
 };
 
-// Integral over the circle of angles, on equal panels (each adaptive), so that narrow lobes
-// are sampled.
+// Integral over [from, to] on equal panels (each adaptive) so that narrow lobes are sampled,
+// with the panels also cut at the given kinks.
 double circleIntegral(const std::function<double(double)>& f, double from, double to,
-                      int panels)
+                      int panels, const std::vector<double>& kinks = {})
 {
-    double sum = 0.0;
-    const double h = (to - from) / panels;
-    for (int i = 0; i < panels; ++i) {
-        sum += integrateAdaptive(f, from + i * h, from + (i + 1) * h, 1e-14, 1e-11);
+    std::vector<double> points;
+    for (int i = 0; i <= panels; ++i) points.push_back(from + (to - from) * i / panels);
+    for (const double k : kinks) {
+        if (k > from && k < to) points.push_back(k);
     }
-    return sum;
+    return integrateAdaptive(f, points, 1e-14, 1e-11);
 }
 
 double positive(double x) { return x > 0.0 ? x : 0.0; }
@@ -54,6 +61,8 @@ struct DiskFrame {
     }
     /// The zeta on chord xi where the shadow chord changes halves (u = 0): a kink.
     double kink(double xi) const { return std::abs(cl) > 1e-12 ? -xi * sl / cl : 2.0; }
+    /// Chord offsets where that kink enters or leaves a half chord: kinks of the outer integral.
+    std::vector<double> chordBreaks() const { return {-1.0, -std::abs(cl), 0.0, std::abs(cl), 1.0}; }
 };
 
 double halfChordRho(double xi) { return std::sqrt(std::max(0.0, 1.0 - xi * xi)); }
@@ -80,11 +89,13 @@ double viewLayers(double zeta, double rho, double nuV, double nuVbar)
 double needleDiffuse(const Vec3& axis, const Vec3& L, const Vec3& V)
 {
     const CylinderNormals n(axis);
+    std::vector<double> kinks = n.terminator(L);
+    for (const double k : n.terminator(V)) kinks.push_back(k);
     const double num = circleIntegral(
         [&](double a) { return positive(glm::dot(n.at(a), L)) * positive(glm::dot(n.at(a), V)); },
-        0.0, 2.0 * kPi, 64);
-    const double den =
-        circleIntegral([&](double a) { return positive(glm::dot(n.at(a), V)); }, 0.0, 2.0 * kPi, 64);
+        0.0, 2.0 * kPi, 64, kinks);
+    const double den = circleIntegral([&](double a) { return positive(glm::dot(n.at(a), V)); },
+                                      0.0, 2.0 * kPi, 64, n.terminator(V));
     return den > 0.0 ? num / den : 0.0;
 }
 
@@ -98,9 +109,9 @@ double needleSpecular(const Vec3& axis, const Vec3& L, const Vec3& V, double exp
             const double nh = positive(glm::dot(n.at(a), *H));
             return nh > 0.0 ? std::pow(nh, exponent) * positive(glm::dot(n.at(a), V)) : 0.0;
         },
-        0.0, 2.0 * kPi, 512);
-    const double den =
-        circleIntegral([&](double a) { return positive(glm::dot(n.at(a), V)); }, 0.0, 2.0 * kPi, 64);
+        0.0, 2.0 * kPi, 512, n.terminator(V));
+    const double den = circleIntegral([&](double a) { return positive(glm::dot(n.at(a), V)); },
+                                      0.0, 2.0 * kPi, 64, n.terminator(V));
     return den > 0.0 ? num / den : 0.0;
 }
 
@@ -109,7 +120,7 @@ double needleProjectedArea(const Vec3& axis, const Vec3& V, double radius_cm, do
     const CylinderNormals n(axis);
     return radius_cm * length_cm *
            circleIntegral([&](double a) { return positive(glm::dot(n.at(a), V)); }, 0.0,
-                          2.0 * kPi, 64);
+                          2.0 * kPi, 64, n.terminator(V));
 }
 
 ConeIntegrals coneIntegrals(double aperture_rad, const Vec3& axis, const Vec3& L, const Vec3& V,
@@ -158,7 +169,7 @@ BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool sh
     const double nuL = view.kL * scale, nuLbar = view.kLbar * scale;
     const DiskFrame disk(view.cosLV);
     const auto overXi = [&](const std::function<double(double)>& perChord) {
-        return 0.5 * integrateAdaptive(perChord, -1.0, 1.0, 1e-11, 1e-9);
+        return 0.5 * integrateAdaptive(perChord, disk.chordBreaks(), 1e-12, 1e-10);
     };
     out.alpha.front = overXi([&](double xi) {
         return 1.0 - std::exp(-mu * nuV * halfChordRho(xi));
@@ -205,7 +216,7 @@ FrontRear boughLinearized(const BoughGeometry& bough, const BoughView& view)
                 };
                 return overHalfChord(f, disk, xi, front, 1e-13);
             },
-            -1.0, 1.0, 1e-12);
+            disk.chordBreaks(), 1e-12);
     }
     return out;
 }
@@ -222,7 +233,7 @@ SweptAreas sweptAreas(double cosLV)
                 };
                 return overHalfChord(f, disk, xi, viewFront, 1e-13);
             },
-            -1.0, 1.0, 1e-11);
+            disk.chordBreaks(), 1e-12);
     };
     return {region(true, true), region(false, true), region(true, false), region(false, false)};
 }

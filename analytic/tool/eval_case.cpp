@@ -163,6 +163,43 @@ json evaluateBough(CaseReader& r, const Vec3& axis, const Vec3& L, const Vec3& V
             {"I_rear_exact", cylRear * exact.transfer.rear}};
 }
 
+// Builds the JSON of one line while remembering the last key read, so that a number JSON
+// cannot hold (1e999 overflows a double) is reported against its key, not as a bare parse error.
+class KeyTrackingParser : public nlohmann::detail::json_sax_dom_parser<json> {
+public:
+    explicit KeyTrackingParser(json& result) : json_sax_dom_parser(result, false) {}
+    bool key(json::string_t& k)
+    {
+        mLastKey = k;
+        return json_sax_dom_parser::key(k);
+    }
+    bool parse_error(std::size_t position, const std::string& token,
+                     const nlohmann::detail::exception& e)
+    {
+        mOverflow = e.id == 406;  // out_of_range.406: number overflow
+        mMessage = e.what();
+        return json_sax_dom_parser::parse_error(position, token, e);
+    }
+    bool overflow() const { return mOverflow; }
+    const std::string& lastKey() const { return mLastKey; }
+    const std::string& message() const { return mMessage; }
+
+private:
+    std::string mLastKey, mMessage;
+    bool mOverflow = false;
+};
+
+json parseLine(const std::string& line)
+{
+    json result;
+    KeyTrackingParser parser(result);
+    if (!json::sax_parse(line, &parser)) {
+        if (parser.overflow()) throw CaseError(parser.lastKey(), "must be finite");
+        throw json::parse_error::create(101, 0, parser.message(), nullptr);
+    }
+    return result;
+}
+
 }  // namespace
 
 json evaluateCase(const json& input)
@@ -191,9 +228,9 @@ int runEval(std::istream& in, std::ostream& out, std::ostream& err)
     for (long number = 1; std::getline(in, line); ++number) {
         if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
         try {
-            const json input = json::parse(line);
+            const json input = parseLine(line);
             out << evaluateCase(input).dump() << '\n';
-        } catch (const json::parse_error& e) {
+        } catch (const json::exception& e) {
             err << "analytic eval: line " << number << ": not JSON (" << e.what() << ")\n";
             return 2;
         } catch (const CaseError& e) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <functional>
+#include <vector>
 
 namespace pine::analytic {
 
@@ -39,5 +40,10 @@ double gaussLegendre8(F&& f, double a, double b)
 /// For reference values only: it is slow by design. Returns NaN when f is not finite.
 double integrateAdaptive(const std::function<double(double)>& f, double a, double b,
                          double absTol = 1e-12, double relTol = 1e-10, int maxDepth = 40);
+
+/// The same over consecutive `points` (sorted ascending): a known kink or peak at a point
+/// never sits inside a panel, where Gauss-Kronrod's error estimate can be fooled.
+double integrateAdaptive(const std::function<double(double)>& f, std::vector<double> points,
+                         double absTol = 1e-12, double relTol = 1e-10);
 
 }  // namespace pine::analytic
