@@ -205,7 +205,7 @@ nlohmann::json sweepLinearLaw(const fs::path& dir)
     opacityCsv << "A,nA,alpha_linear_unclamped,alpha_linear,alpha_exact,rel_error_unclamped\n";
     const Vec3 side(0, 1, 0);
     nlohmann::json thresholds;
-    for (const double A : {0.05, 0.2349, 0.5}) {
+    for (const double A : {0.01, 0.05, 0.2349, 0.5}) {
         BoughGeometry b = paperBough();
         b.cone.needlesPerCone = A * kPi * boughRadius(b.cone) / (2.0 * b.cone.needleRadius_cm);
         // The largest nA below which the law holds within each bound (first exceedance: at

@@ -189,6 +189,41 @@ TEST(ConeShader, LayerOpacityIsTheNeedlesMeanCoverageOfTheCone)
     EXPECT_NEAR(layerOpacity(cone), covered / area, 1e-12);
 }
 
+TEST(ConeShader, SumsMatchExplicitNeedles)
+{
+    // The normalisation of the sums (section 5's l A / 4 drops R / 2): N explicit needles at
+    // azimuths 2 pi i / N + offset, each contributing 2 r l s_v and that times eq. (1)/(2),
+    // averaged over the offset, must give the continuous sums. A smooth lobe (n = 20) keeps
+    // the discrete sum converged at N = 360.
+    const ConeGeometry cone{0.5, 4.0, 0.05, 360};
+    const double n = 20.0;
+    test::RandomDirections rnd(27);
+    for (int k = 0; k < 20; ++k) {
+        const Vec3 axis = rnd.direction(), L = rnd.direction(), V = rnd.direction();
+        const ConeFrame f = coneFrame(cone.aperture_rad, axis, L, V);
+        ConeFaceSums front, rear;
+        const int offsets = 16;
+        for (int o = 0; o < offsets; ++o) {
+            for (int i = 0; i < int(cone.needlesPerCone); ++i) {
+                const double t = 2 * kPi * (i + (o + 0.5) / offsets) / cone.needlesPerCone;
+                const Vec3 a = f.needle(t);
+                const double area = needleProjectedArea(a, V, cone.needleRadius_cm, cone.needleLength_cm) / offsets;
+                ConeFaceSums& face = std::cos(t) >= 0.0 ? front : rear;
+                face.area += area;
+                face.diffuse += area * needleDiffuse(a, L, V);
+                face.specular += area * needleSpecular(a, L, V, n);
+            }
+        }
+        const ConeSums sums = coneSums(cone, coneIntegrals(cone.aperture_rad, axis, L, V, n), n);
+        EXPECT_NEAR(sums.front.area, front.area, 1e-3 * front.area);
+        EXPECT_NEAR(sums.rear.area, rear.area, 1e-3 * rear.area);
+        EXPECT_NEAR(sums.front.diffuse, front.diffuse, 2e-3 * (front.diffuse + rear.diffuse) + 1e-9);
+        EXPECT_NEAR(sums.rear.diffuse, rear.diffuse, 2e-3 * (front.diffuse + rear.diffuse) + 1e-9);
+        EXPECT_NEAR(sums.front.specular, front.specular, 1e-2 * (front.specular + rear.specular) + 1e-9);
+        EXPECT_NEAR(sums.rear.specular, rear.specular, 1e-2 * (front.specular + rear.specular) + 1e-9);
+    }
+}
+
 TEST(ConeShader, ShadingIsBoundedByItsCoverage)
 {
     test::RandomDirections rnd(25);
