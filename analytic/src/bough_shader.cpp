@@ -101,7 +101,8 @@ BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool sh
     // nodes on each piece).
     const double sharpness = A < 1.0 ? mu * std::max({nuV, nuVbar, shadows ? nuL : 0.0,
                                                       shadows ? nuLbar : 0.0}) : 0.0;
-    const int panels = std::isfinite(sharpness) ? std::clamp(int(std::ceil(sharpness / 6.0)), 2, 8) : 8;
+    const int panels =
+        std::isfinite(sharpness) ? std::clamp(int(std::ceil(sharpness / 6.0)), 2, 8) : 8;
 
     // Unit-disk frame: zeta along V_p (towards the viewer), xi across; e_l at angle l_v.
     const double cl = view.cosLV, sl = std::sqrt(std::max(0.0, 1.0 - cl * cl));

@@ -38,7 +38,6 @@ double productIntegral(const Harmonic& l, const Harmonic& v, double sign)
     return kPi * l.u * v.u + sign * 2.0 * (l.u * v.p + l.p * v.u) + kHalfPi * l.p * v.p;
 }
 
-
 // S of both faces. c_h(theta) = u + w cos(psi), psi = theta - theta_H, is nearest zero at the
 // extremum psi_e (0 if u < 0, pi if u > 0), with roots c_h = 0 at psi_e +- delta when |u| <= w.
 // Laplace's method (the paper's eq. 5) gives each root a peak of width 1 / (|c_h'| sqrt(n - 1)),
@@ -48,9 +47,8 @@ double productIntegral(const Harmonic& l, const Harmonic& v, double sign)
 // we integrate the exact integrand by Gauss-Legendre on windows of +-6 such widths placed
 // where Laplace's analysis puts the peaks, split at the faces' edges: correct in all regimes,
 // and O(1) in n: at most 2 windows x 4 panels x 8 nodes.
-std::pair<double, double> specularFaceIntegrals(const Harmonic& hv,
-                                                const Harmonic& hh, const Vec3& H, const Vec3& V,
-                                                double exponent)
+std::pair<double, double> specularFaceIntegrals(const Harmonic& hv, const Harmonic& hh,
+                                                const Vec3& H, const Vec3& V, double exponent)
 {
     const double kappa = exponent - 1.0;
     const double w = std::hypot(hh.p, hh.q);
@@ -63,19 +61,17 @@ std::pair<double, double> specularFaceIntegrals(const Harmonic& hv,
     const double psiE = hh.u < 0.0 ? 0.0 : kPi;
     const double quartic = std::pow(8.0 / (kappa * w * w), 0.25);
     std::vector<std::pair<double, double>> windows;  // in psi, relative to psi_e
-    double sigmaOf = quartic;                        // the peaks' width
+    double peakWidth;                                // std-dev of each peak, in psi
     if (gap <= 0.0) {
         const double delta = std::acos(std::min(1.0, absU / w));
-        const double sigma = std::min(quartic, 1.0 / (std::sqrt((w - absU) * (w + absU) * kappa)));
-        sigmaOf = sigma;
+        peakWidth = std::min(quartic, 1.0 / std::sqrt((w - absU) * (w + absU) * kappa));
         // One window per peak, meeting at the extremum between them where they overlap: a
         // merged window would hold two narrow peaks too few nodes apart.
-        windows = {{-delta - 6.0 * sigma, std::min(-delta + 6.0 * sigma, 0.0)},
-                   {std::max(delta - 6.0 * sigma, 0.0), delta + 6.0 * sigma}};
+        windows = {{-delta - 6.0 * peakWidth, std::min(-delta + 6.0 * peakWidth, 0.0)},
+                   {std::max(delta - 6.0 * peakWidth, 0.0), delta + 6.0 * peakWidth}};
     } else {
-        const double sigma = std::min(quartic, 1.0 / std::sqrt(kappa * gap * w));
-        sigmaOf = sigma;
-        windows = {{-6.0 * sigma, 6.0 * sigma}};
+        peakWidth = std::min(quartic, 1.0 / std::sqrt(kappa * gap * w));
+        windows = {{-6.0 * peakWidth, 6.0 * peakWidth}};
     }
     const double VH = glm::dot(V, H);
     const auto lobe = [&](double theta) {
@@ -91,16 +87,18 @@ std::pair<double, double> specularFaceIntegrals(const Harmonic& hv,
         // Split at the faces' edges, theta = +-pi/2 (mod 2 pi), between a and b.
         const double from = thetaH + psiE + a, to = thetaH + psiE + b;
         std::vector<double> cuts{from};
-        for (double edge = std::ceil((from - kHalfPi) / kPi) * kPi + kHalfPi; edge < to; edge += kPi) {
+        const double firstEdge = std::ceil((from - kHalfPi) / kPi) * kPi + kHalfPi;
+        for (double edge = firstEdge; edge < to; edge += kPi) {
             if (edge > from) cuts.push_back(edge);
         }
         cuts.push_back(to);
         for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
             // Panels at most 3 peak widths wide (4 over a whole window): 8 nodes each.
-            const int panels = std::clamp(int(std::ceil((cuts[i + 1] - cuts[i]) / (3.0 * sigmaOf))), 1, 4);
+            const double length = cuts[i + 1] - cuts[i];
+            const int panels = std::clamp(int(std::ceil(length / (3.0 * peakWidth))), 1, 4);
             double piece = 0.0;
             for (int k = 0; k < panels; ++k) {
-                const double h = (cuts[i + 1] - cuts[i]) / panels;
+                const double h = length / panels;
                 piece += gaussLegendre8(lobe, cuts[i] + k * h, cuts[i] + (k + 1) * h);
             }
             const double mid = std::remainder(0.5 * (cuts[i] + cuts[i + 1]), 2.0 * kPi);
@@ -140,8 +138,8 @@ ConeFrame coneFrame(double aperture_rad, const Vec3& axis, const Vec3& L, const 
     // e1 along V_p puts theta_V at 0; with V on the axis any azimuth serves, L_p is stable.
     if (auto e = safeNormalize(v.perp); e && v.s > 1e-12) {
         f.e1 = *e;
-    } else if (auto e2 = safeNormalize(l.perp); e2 && l.s > 1e-12) {
-        f.e1 = *e2;
+    } else if (auto lp = safeNormalize(l.perp); lp && l.s > 1e-12) {
+        f.e1 = *lp;
     } else {
         f.e1 = anyPerpendicular(axis);
     }
@@ -205,13 +203,10 @@ FaceReflectance meanReflectance(const ConeFaceSums& face)
 
 ConeShading shadeCone(const ConeSums& sums, double footprintArea_cm2)
 {
-    const auto alpha = [&](double area) {
-        if (!(area > 0.0)) return 0.0;
-        return footprintArea_cm2 > area ? area / footprintArea_cm2 : 1.0;
-    };
+    // The face's needles cover the footprint as one needle of their summed area would (eq. 3).
     ConeShading s;
-    s.alphaFront = alpha(sums.front.area);
-    s.alphaRear = alpha(sums.rear.area);
+    s.alphaFront = needleOpacity(sums.front.area, footprintArea_cm2);
+    s.alphaRear = needleOpacity(sums.rear.area, footprintArea_cm2);
     const FaceReflectance front = meanReflectance(sums.front), rear = meanReflectance(sums.rear);
     s.diffuseFront = s.alphaFront * front.diffuse;
     s.specularFront = s.alphaFront * front.specular;
