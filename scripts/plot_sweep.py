@@ -142,14 +142,14 @@ def panel_opacity_error(ax, o, pb):
     ax.set_yscale("log")
     for lev in LEVELS:
         ax.axhline(lev, color="gray", lw=0.8, ls=":")
-        ax.text(o["nA"].min() * 1.2, lev * 1.08, LEVEL_NAMES[lev], fontsize=9,
-                color="dimgray", va="bottom")
+        ax.text(pb["nA"] * 0.85, lev / 1.08, LEVEL_NAMES[lev], fontsize=9,
+                color="dimgray", ha="right", va="top")
     ax.axvline(pb["nA"], color="k", lw=0.8, ls="--")
-    ax.text(pb["nA"] * 0.92, 0.97, "paper's bough", transform=ax.get_xaxis_transform(),
-            rotation=90, ha="right", va="top", fontsize=9)
+    ax.text(pb["nA"] * 0.92, 0.03, "paper's bough", transform=ax.get_xaxis_transform(),
+            rotation=90, ha="right", va="bottom", fontsize=9)
     ax.set_xlabel(NA_LABEL)
     ax.set_ylabel("relative error of opacity |linear - exact| / exact")
-    ax.legend(loc="lower right", fontsize=9)
+    ax.legend(loc="lower left", fontsize=9)
     ax.set_title("(c) linear-law opacity error, view orthogonal (unclamped)")
 
 
