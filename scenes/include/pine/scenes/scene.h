@@ -1,0 +1,109 @@
+// A scene: camera, lights, ground, trees and what to compute (docs/scene-format.md).
+// World space is right-handed, z up; lengths in cm (the paper's unit), angles in degrees in the
+// file and radians in memory.
+#pragma once
+
+#include "pine/scenes/species.h"
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pine::scenes {
+
+using Vec3 = glm::dvec3;
+using Vec2 = glm::dvec2;
+
+/// A scene file that cannot be used: the message is one line naming file, key and, where the
+/// parser gives it, line:column ("scenes/x.json:12:7: camera.fov_deg: must be in (0, 180)").
+class SceneError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct Camera {
+    Vec3 position_cm{0.0, -500.0, 100.0};
+    Vec3 lookAt_cm{0.0, 0.0, 100.0};
+    Vec3 up{0.0, 0.0, 1.0};
+    double fovY_rad = 0.7;  ///< vertical field of view
+    int width = 640, height = 480;
+};
+
+struct PointLight {
+    Vec3 position_cm{0.0};
+    Vec3 colour{1.0};
+    double intensity = 1.0;  ///< radiant intensity: irradiance at distance d is intensity / d^2
+};
+
+struct DirectionalLight {
+    Vec3 towardsLight{0.0, 0.0, 1.0};  ///< unit
+    Vec3 colour{1.0};
+    double irradiance = 1.0;  ///< on a surface facing the light
+};
+
+struct Ground {
+    enum class Kind { None, Plane, Hill };
+    Kind kind = Kind::Plane;
+    double height_cm = 0.0;  ///< plane height; the hill's base height
+    // Hill: z = height + peak * exp(-|xy - centre|^2 / (2 radius^2)).
+    double hillPeak_cm = 0.0;
+    double hillRadius_cm = 1.0;
+    Vec2 hillCentre_cm{0.0};
+    Vec3 albedo{0.3, 0.25, 0.2};
+    /// Height of the ground under (x, y).
+    double heightAt(double x_cm, double y_cm) const;
+};
+
+/// What the scene asks the tracer to compute; nothing else is computed (DESIGN.md).
+struct Effects {
+    bool diffuse = true;
+    bool specular = false;
+    bool shadows = false;        ///< shadows cast by trees on each other and on the ground
+    bool selfShadowing = false;  ///< shadowing inside a bough (the paper's section 6 terms)
+};
+
+/// A tree: species, placement and the seed of its L-system.
+struct TreePlacement {
+    std::string species;
+    Vec3 base_cm{0.0};     ///< where the trunk meets the ground (z set on the ground if absent)
+    double height_cm = 0;  ///< scale the grown tree to this height; 0 keeps the species' own
+    double rotation_rad = 0;  ///< about z
+    unsigned seed = 1;
+};
+
+struct RenderSettings {
+    Vec3 background{0.55, 0.7, 0.9};
+    /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
+    /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):
+    /// q < needleLevelMax: level 1, needles resolved; q < coneLevelMax: level 2, each cone a
+    /// semi-opaque surface; otherwise level 3, the bough a volume.
+    double needleLevelMax = 0.25;
+    double coneLevelMax = 1.0;
+};
+
+struct Scene {
+    std::filesystem::path source;  ///< the file it came from (for messages and metadata)
+    std::string name;
+    Camera camera;
+    std::vector<PointLight> pointLights;
+    std::vector<DirectionalLight> directionalLights;
+    Ground ground;
+    std::map<std::string, Species> species;
+    std::vector<TreePlacement> trees;  ///< explicit placements and scattered ones, expanded
+    Effects effects;
+    RenderSettings render;
+};
+
+/// Reads and validates a scene file. Throws SceneError (one line, see above) on malformed JSON,
+/// a key nobody reads, a missing or non-finite value, a negative size, an unknown species.
+Scene loadScene(const std::filesystem::path& file);
+
+/// The same from text (for tests); `name` stands for the file in messages.
+Scene parseScene(const std::string& json, const std::filesystem::path& name);
+
+}  // namespace pine::scenes

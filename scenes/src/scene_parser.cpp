@@ -1,0 +1,203 @@
+// Scene files: loadScene / parseScene and the small sections (camera, lights, ground, effects,
+// render). Keys, units, defaults and valid ranges: docs/scene-format.md.
+#include "scene_sections.h"
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+namespace pine::scenes {
+namespace {
+
+using detail::Json;
+using detail::ObjectReader;
+using detail::Range;
+using detail::Where;
+
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+constexpr long long kMaxResolution = 16384;
+const Vec3 kWhite{1.0};
+
+Camera readCamera(const Json& value, const Where& where)
+{
+    ObjectReader r(value, where);
+    Camera c;
+    c.position_cm = r.vec3("position");
+    c.lookAt_cm = r.vec3("look_at");
+    const Vec3 view = c.lookAt_cm - c.position_cm;
+    if (!(glm::length(view) > 0.0)) {
+        where.key("look_at").fail("equals position (no view direction)");
+    }
+    if (const Json* up = r.optional("up")) c.up = detail::readDirection(*up, where.key("up"));
+    // An up vector along the view leaves the image's roll undefined.
+    if (glm::length(glm::cross(glm::normalize(view), c.up)) < 1e-6) {
+        where.key("up").fail("must not be parallel to the view direction");
+    }
+    c.fovY_rad = kRadPerDeg * r.number("fov_deg", Range::open(0, 180), c.fovY_rad / kRadPerDeg);
+    if (const Json* resolution = r.optional("resolution")) {
+        const Where at = where.key("resolution");
+        if (!resolution->is_array() || resolution->size() != 2) {
+            at.fail("must be [width, height] in pixels");
+        }
+        c.width = static_cast<int>(detail::readInteger((*resolution)[0], at.index(0), 1,
+                                                       kMaxResolution));
+        c.height = static_cast<int>(detail::readInteger((*resolution)[1], at.index(1), 1,
+                                                        kMaxResolution));
+    }
+    r.finish();
+    return c;
+}
+
+void readLights(const Json& value, const Where& where, Scene& scene)
+{
+    if (!value.is_array() || value.empty()) where.fail("must be an array of at least one light");
+    for (std::size_t i = 0; i < value.size(); ++i) {
+        ObjectReader r(value[i], where.index(i));
+        const std::string type = r.string("type");
+        if (type == "point") {
+            PointLight l;
+            l.position_cm = r.vec3("position");
+            l.colour = r.colour("colour", Range::atLeast(0), kWhite);
+            l.intensity = r.number("intensity", Range::atLeast(0), l.intensity);
+            scene.pointLights.push_back(l);
+        } else if (type == "directional") {
+            DirectionalLight l;
+            l.towardsLight = detail::readDirection(r.required("direction"),
+                                                   r.where().key("direction"));
+            l.colour = r.colour("colour", Range::atLeast(0), kWhite);
+            l.irradiance = r.number("irradiance", Range::atLeast(0), l.irradiance);
+            scene.directionalLights.push_back(l);
+        } else {
+            r.where().key("type").fail("must be \"point\" or \"directional\" (is \"" + type +
+                                       "\")");
+        }
+        r.finish();
+    }
+}
+
+Ground readGround(const Json& value, const Where& where)
+{
+    ObjectReader r(value, where);
+    Ground g;
+    const std::string type = r.string("type");
+    if (type == "none") {
+        g.kind = Ground::Kind::None;
+    } else if (type == "plane") {
+        g.kind = Ground::Kind::Plane;
+    } else if (type == "hill") {
+        g.kind = Ground::Kind::Hill;
+    } else {
+        where.key("type").fail("must be \"plane\", \"hill\" or \"none\" (is \"" + type + "\")");
+    }
+    g.height_cm = r.number("height", Range::any(), g.height_cm);
+    if (g.kind == Ground::Kind::Hill) {
+        g.hillPeak_cm = r.number("peak", Range::any());
+        g.hillRadius_cm = r.number("radius", Range::above(0));
+        if (const Json* centre = r.optional("centre")) {
+            g.hillCentre_cm = detail::readVec2(*centre, where.key("centre"));
+        }
+    }
+    // No ground, no surface to colour: "albedo" is then a key nobody reads.
+    if (g.kind != Ground::Kind::None) g.albedo = r.colour("albedo", Range::closed(0, 1), g.albedo);
+    r.finish();
+    return g;
+}
+
+Effects readEffects(const Json& value, const Where& where)
+{
+    if (!value.is_array()) where.fail("must be an array of effect names");
+    Effects e;
+    e.diffuse = false;  // a list names every effect wanted; nothing else is computed
+    for (std::size_t i = 0; i < value.size(); ++i) {
+        const std::string name = detail::readString(value[i], where.index(i));
+        bool* flag = name == "diffuse"          ? &e.diffuse
+                     : name == "specular"       ? &e.specular
+                     : name == "shadows"        ? &e.shadows
+                     : name == "self_shadowing" ? &e.selfShadowing
+                                                : nullptr;
+        if (!flag) {
+            where.index(i).fail("unknown effect \"" + name +
+                                "\" (known: diffuse, specular, shadows, self_shadowing)");
+        }
+        if (*flag) where.index(i).fail("effect \"" + name + "\" named twice");
+        *flag = true;
+    }
+    return e;
+}
+
+RenderSettings readRender(const Json& value, const Where& where)
+{
+    ObjectReader r(value, where);
+    RenderSettings s;
+    s.background = r.colour("background", Range::atLeast(0), s.background);
+    s.needleLevelMax = r.number("needle_level_max", Range::above(0), s.needleLevelMax);
+    s.coneLevelMax = r.number("cone_level_max", Range::above(0), s.coneLevelMax);
+    if (!(s.coneLevelMax > s.needleLevelMax)) {
+        where.key("cone_level_max").fail("must exceed needle_level_max (" +
+                                         detail::formatNumber(s.needleLevelMax) + ")");
+    }
+    r.finish();
+    return s;
+}
+
+}  // namespace
+
+Scene parseScene(const std::string& json, const std::filesystem::path& name)
+{
+    const std::string file = name.string();
+    const Json document = detail::parseJsonDocument(json, file);
+    const Where top{&file, ""};
+    ObjectReader r(document, top);
+
+    Scene scene;
+    scene.source = name;
+    scene.name = r.string("name", name.stem().string());
+    scene.camera = readCamera(r.required("camera"), top.key("camera"));
+    readLights(r.required("lights"), top.key("lights"), scene);
+    if (const Json* ground = r.optional("ground")) {
+        scene.ground = readGround(*ground, top.key("ground"));
+    }
+    if (const Json* species = r.optional("species")) {
+        ObjectReader s(*species, top.key("species"));
+        for (const auto& [speciesName, value] : species->items()) {
+            if (speciesName == "comment") continue;
+            if (speciesName.empty()) s.where().key(speciesName).fail("a species needs a name");
+            scene.species.emplace(speciesName,
+                                  detail::readSpecies(*s.optional(speciesName),
+                                                      s.where().key(speciesName)));
+        }
+        s.finish();
+    }
+    // After species and ground: placements name the one and stand on the other.
+    scene.trees = detail::readTrees(r.required("trees"), top.key("trees"), scene);
+    if (const Json* effects = r.optional("effects")) {
+        scene.effects = readEffects(*effects, top.key("effects"));
+    }
+    if (const Json* render = r.optional("render")) {
+        scene.render = readRender(*render, top.key("render"));
+    }
+    r.finish();
+    return scene;
+}
+
+Scene loadScene(const std::filesystem::path& file)
+{
+    std::error_code ec;
+    if (!std::filesystem::exists(file, ec)) {
+        throw SceneError(file.string() + ": cannot open: no such file");
+    }
+    if (!std::filesystem::is_regular_file(file, ec)) {
+        throw SceneError(file.string() + ": cannot open: not a regular file");
+    }
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw SceneError(file.string() + ": cannot open: permission denied or unreadable");
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad()) throw SceneError(file.string() + ": cannot read");
+    return parseScene(text.str(), file);
+}
+
+}  // namespace pine::scenes

@@ -1,0 +1,519 @@
+// Scene files: values arrive where the header says, in its units; every bad input gets one line
+// "FILE[:LINE:COL]: key.path: problem" (docs/scene-format.md, "Errors").
+#include "test_support.h"
+
+#include "pine/scenes/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <cmath>
+#include <numbers>
+
+namespace pine::scenes {
+namespace {
+
+using test::errorOf;
+using test::errorOfText;
+using test::fullScene;
+using test::json;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Every message is a single line that starts with the file's name.
+void expectOneLine(const std::string& message, const std::string& file = "test.json")
+{
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_EQ(message.rfind(file, 0), 0u) << message;
+}
+
+// The error for `j`, which must be one; the key path must appear in it.
+std::string expectError(const json& j, const std::string& path, const std::string& problem)
+{
+    const std::string message = errorOf(j);
+    EXPECT_NE(message, "") << "accepted, but " << path << " should be rejected";
+    expectOneLine(message);
+    EXPECT_NE(message.find(": " + path + ": "), std::string::npos) << message;
+    EXPECT_NE(message.find(problem), std::string::npos) << message;
+    return message;
+}
+
+json minimalScene()
+{
+    return json::parse(R"({
+      "camera": {"position": [0, -500, 100], "look_at": [0, 0, 100]},
+      "lights": [{"type": "directional", "direction": [0, 0, 1]}],
+      "trees": []
+    })");
+}
+
+TEST(SceneParser, MinimalSceneTakesTheHeaderDefaults)
+{
+    const Scene s = parseScene(minimalScene().dump(), "dir/minimal.json");
+    const Camera camera;
+    const Ground ground;
+    const RenderSettings render;
+    EXPECT_EQ(s.name, "minimal");  // the file's stem
+    EXPECT_EQ(s.source, "dir/minimal.json");
+    EXPECT_DOUBLE_EQ(s.camera.fovY_rad, camera.fovY_rad);
+    EXPECT_EQ(s.camera.width, 640);
+    EXPECT_EQ(s.camera.height, 480);
+    EXPECT_EQ(s.camera.up, Vec3(0, 0, 1));
+    EXPECT_EQ(s.ground.kind, Ground::Kind::Plane);
+    EXPECT_EQ(s.ground.height_cm, ground.height_cm);
+    EXPECT_EQ(s.ground.albedo, ground.albedo);
+    EXPECT_TRUE(s.effects.diffuse);
+    EXPECT_FALSE(s.effects.specular || s.effects.shadows || s.effects.selfShadowing);
+    EXPECT_EQ(s.render.background, render.background);
+    EXPECT_EQ(s.render.needleLevelMax, render.needleLevelMax);
+    EXPECT_EQ(s.render.coneLevelMax, render.coneLevelMax);
+    EXPECT_TRUE(s.trees.empty());
+    EXPECT_TRUE(s.species.empty());
+}
+
+TEST(SceneParser, RoundTripsEveryValueInMemoryUnits)
+{
+    const Scene s = parseScene(fullScene().dump(), "full.json");
+    EXPECT_EQ(s.name, "full");
+
+    EXPECT_EQ(s.camera.position_cm, Vec3(1, -400, 120));
+    EXPECT_EQ(s.camera.lookAt_cm, Vec3(1, 0, 90));
+    EXPECT_EQ(s.camera.up, Vec3(0, 0, 1));  // unit length in memory
+    EXPECT_DOUBLE_EQ(s.camera.fovY_rad, 30 * kDeg);
+    EXPECT_EQ(s.camera.width, 320);
+    EXPECT_EQ(s.camera.height, 240);
+
+    ASSERT_EQ(s.pointLights.size(), 1u);
+    EXPECT_EQ(s.pointLights[0].position_cm, Vec3(10, 20, 300));
+    EXPECT_EQ(s.pointLights[0].colour, Vec3(1, 0.5, 0.25));
+    EXPECT_EQ(s.pointLights[0].intensity, 900);
+    ASSERT_EQ(s.directionalLights.size(), 1u);
+    EXPECT_EQ(s.directionalLights[0].towardsLight, Vec3(0, 0, 1));
+    EXPECT_EQ(s.directionalLights[0].colour, Vec3(0.5, 0.5, 1));
+    EXPECT_EQ(s.directionalLights[0].irradiance, 2);
+
+    EXPECT_EQ(s.ground.kind, Ground::Kind::Hill);
+    EXPECT_EQ(s.ground.height_cm, -10);
+    EXPECT_EQ(s.ground.hillPeak_cm, 200);
+    EXPECT_EQ(s.ground.hillRadius_cm, 300);
+    EXPECT_EQ(s.ground.hillCentre_cm, Vec2(50, -20));
+    EXPECT_EQ(s.ground.albedo, Vec3(0.2, 0.3, 0.1));
+
+    ASSERT_EQ(s.species.count("fir"), 1u);
+    const Species& f = s.species.at("fir");
+    EXPECT_EQ(f.axiom, "A");
+    ASSERT_EQ(f.rules.size(), 2u);
+    EXPECT_EQ(f.rules.at('A'), "F[&B]/[&B]/[&B]!A");  // spaces dropped
+    EXPECT_EQ(f.rules.at('B'), "FB");
+    EXPECT_EQ(f.iterations, 4);
+    EXPECT_DOUBLE_EQ(f.branchAngle_rad, 70 * kDeg);
+    EXPECT_DOUBLE_EQ(f.divergence_rad, 120 * kDeg);
+    EXPECT_EQ(f.segment_cm, 12);
+    EXPECT_EQ(f.trunkRadius_cm, 2);
+    EXPECT_EQ(f.lengthDecay, 0.9);
+    EXPECT_EQ(f.radiusDecay, 0.8);
+    EXPECT_EQ(f.branchRadiusRatio, 0.25);
+    EXPECT_DOUBLE_EQ(f.jitter_rad, 3 * kDeg);
+    EXPECT_DOUBLE_EQ(f.needlesAtBase.aperture_rad, 22.5 * kDeg);
+    EXPECT_EQ(f.needlesAtBase.length_cm, 4.25);
+    EXPECT_EQ(f.needlesAtBase.radius_cm, 0.05);
+    EXPECT_EQ(f.needlesAtBase.perCone, 12);
+    EXPECT_EQ(f.needlesAtBase.coneSpacing_cm, 0.9);
+    // The tip sets two keys; the others come from the base, not from the header.
+    EXPECT_DOUBLE_EQ(f.needlesAtTip.aperture_rad, 30 * kDeg);
+    EXPECT_EQ(f.needlesAtTip.length_cm, 3);
+    EXPECT_EQ(f.needlesAtTip.radius_cm, 0.05);
+    EXPECT_EQ(f.needlesAtTip.perCone, 12);
+    EXPECT_EQ(f.needlesAtTip.coneSpacing_cm, 0.9);
+    EXPECT_EQ(f.barkAlbedo, 0.15);
+    EXPECT_EQ(f.needleAlbedo, 0.4);
+    EXPECT_EQ(f.needleSpecular, 0.2);
+    EXPECT_EQ(f.specularExponent, 80);
+
+    ASSERT_EQ(s.trees.size(), 7u);  // two placed, five scattered
+    EXPECT_EQ(s.trees[0].species, "fir");
+    EXPECT_EQ(s.trees[0].base_cm, Vec3(0, 0, 5));
+    EXPECT_EQ(s.trees[0].height_cm, 150);
+    EXPECT_DOUBLE_EQ(s.trees[0].rotation_rad, 90 * kDeg);
+    EXPECT_EQ(s.trees[0].seed, 42u);
+    // [x, y] stands on the hill; the defaults are height 0 (own size), rotation 0, seed 1.
+    EXPECT_EQ(s.trees[1].base_cm, Vec3(100, 50, s.ground.heightAt(100, 50)));
+    EXPECT_EQ(s.trees[1].height_cm, 0);
+    EXPECT_EQ(s.trees[1].rotation_rad, 0);
+    EXPECT_EQ(s.trees[1].seed, 1u);
+
+    EXPECT_TRUE(s.effects.diffuse && s.effects.specular && s.effects.shadows &&
+                s.effects.selfShadowing);
+    EXPECT_EQ(s.render.background, Vec3(0.1, 0.2, 0.3));
+    EXPECT_EQ(s.render.needleLevelMax, 0.5);
+    EXPECT_EQ(s.render.coneLevelMax, 2);
+}
+
+TEST(SceneParser, EffectsListedAreTheOnlyOnesOn)
+{
+    json j = minimalScene();
+    j["effects"] = {"shadows"};
+    Scene s = parseScene(j.dump(), "e.json");
+    EXPECT_FALSE(s.effects.diffuse);
+    EXPECT_TRUE(s.effects.shadows);
+    EXPECT_FALSE(s.effects.specular || s.effects.selfShadowing);
+    j["effects"] = json::array();
+    s = parseScene(j.dump(), "e.json");
+    EXPECT_FALSE(s.effects.diffuse || s.effects.specular || s.effects.shadows ||
+                 s.effects.selfShadowing);
+}
+
+TEST(SceneParser, ScatterIsSeededInsideItsRegionAndOnTheGround)
+{
+    const json j = fullScene();
+    const Scene a = parseScene(j.dump(), "a.json"), b = parseScene(j.dump(), "b.json");
+    ASSERT_EQ(a.trees.size(), 7u);
+    for (std::size_t i = 2; i < 7; ++i) {
+        const TreePlacement& t = a.trees[i];
+        EXPECT_EQ(t.species, "fir");
+        EXPECT_GE(t.base_cm.x, -500);
+        EXPECT_LT(t.base_cm.x, 500);
+        EXPECT_GE(t.base_cm.y, -500);
+        EXPECT_LT(t.base_cm.y, 500);
+        EXPECT_EQ(t.base_cm.z, a.ground.heightAt(t.base_cm.x, t.base_cm.y));
+        EXPECT_GE(t.height_cm, 80);
+        EXPECT_LT(t.height_cm, 120);
+        EXPECT_GE(t.rotation_rad, 0);
+        EXPECT_LT(t.rotation_rad, 2 * std::numbers::pi);
+        for (std::size_t k = 2; k < i; ++k) {
+            const double d = std::hypot(t.base_cm.x - a.trees[k].base_cm.x,
+                                        t.base_cm.y - a.trees[k].base_cm.y);
+            EXPECT_GE(d, 50) << "trees " << k << " and " << i << " closer than min_spacing";
+        }
+        // Same file, same forest.
+        EXPECT_EQ(t.base_cm, b.trees[i].base_cm);
+        EXPECT_EQ(t.height_cm, b.trees[i].height_cm);
+        EXPECT_EQ(t.seed, b.trees[i].seed);
+    }
+    json other = j;
+    other["trees"][2]["scatter"]["seed"] = 10;
+    const Scene c = parseScene(other.dump(), "c.json");
+    EXPECT_NE(c.trees[2].base_cm, a.trees[2].base_cm);
+}
+
+TEST(SceneParser, ScatterThatCannotKeepItsSpacingSaysSo)
+{
+    json j = fullScene();
+    j["trees"][2]["scatter"]["min_spacing"] = 2000;
+    expectError(j, "trees[2].scatter.min_spacing", "cannot place 5 trees");
+}
+
+TEST(SceneParser, MalformedJsonGivesLineAndColumn)
+{
+    // A trailing comma on line 3, at column 27.
+    const std::string text = "{\n  \"camera\": {\n    \"position\": [0, 0, 1],,\n  }\n}";
+    const std::string message = errorOfText(text, "bad.json");
+    expectOneLine(message, "bad.json");
+    EXPECT_EQ(message.rfind("bad.json:3:27: syntax error", 0), 0u) << message;
+
+    // Trailing text: the column of the character where "tra..." stopped being a literal.
+    const std::string garbage = errorOfText("{\"name\": \"x\"} trailing", "g.json");
+    EXPECT_EQ(garbage.rfind("g.json:1:17: ", 0), 0u) << garbage;
+    EXPECT_EQ(errorOfText("", "empty.json").rfind("empty.json:1:1: ", 0), 0u);
+}
+
+TEST(SceneParser, NumberTooLargeForADoubleNamesItsKeyAndPlace)
+{
+    // nlohmann reports 1e999 as a bare overflow; we name the key and its line and column.
+    const std::string text =
+        "{\n"
+        "  \"camera\": {\"position\": [0, -500, 100], \"look_at\": [0, 0, 100]},\n"
+        "  \"lights\": [{\"type\": \"directional\", \"direction\": [0, 0, 1]}],\n"
+        "  \"trees\": [{\"species\": \"fir\", \"position\": [0, 0],\n"
+        "             \"height\": 1e999}]\n"
+        "}\n";
+    const std::string message = errorOfText(text);
+    expectOneLine(message);
+    EXPECT_EQ(message, "test.json:5:24: trees[0].height: must be finite (number out of range: "
+                       "1e999)");
+    // An element of a vector: the path ends in its index; the column is the number's sign.
+    const std::string inVector = errorOfText(R"({"camera": {"position": [0, -1e400, 0]}})");
+    EXPECT_EQ(inVector.rfind("test.json:1:29: camera.position[1]: must be finite", 0), 0u)
+        << inVector;
+}
+
+TEST(SceneParser, DuplicateKeyIsAnError)
+{
+    const std::string message =
+        errorOfText(R"({"camera": {"position": [0, 0, 1], "position": [0, 0, 2]}})");
+    expectOneLine(message);
+    EXPECT_NE(message.find("camera.position: duplicate key"), std::string::npos) << message;
+}
+
+// A key nobody reads is an error wherever it sits (pbrt-v4's ReportUnused): a typo must never
+// fall back to a default in silence.
+TEST(SceneParser, RejectsAKeyNobodyReadsAnywhere)
+{
+    const std::vector<std::vector<std::string>> places = {
+        {},
+        {"camera"},
+        {"lights", "0"},
+        {"lights", "1"},
+        {"ground"},
+        {"species", "fir"},
+        {"species", "fir", "lsystem"},
+        {"species", "fir", "needles"},
+        {"species", "fir", "needles", "base"},
+        {"species", "fir", "needles", "tip"},
+        {"trees", "0"},
+        {"trees", "2"},
+        {"trees", "2", "scatter"},
+        {"render"},
+    };
+    for (const auto& place : places) {
+        json j = fullScene();
+        json* node = &j;
+        std::string path;
+        for (const std::string& step : place) {
+            const bool index = std::isdigit(static_cast<unsigned char>(step[0]));
+            node = index ? &(*node)[std::stoul(step)] : &(*node)[step];
+            path += index ? "[" + step + "]" : (path.empty() ? "" : ".") + step;
+        }
+        (*node)["colour_typo"] = 1;
+        expectError(j, path.empty() ? "colour_typo" : path + ".colour_typo", "unknown key");
+    }
+    // A key that belongs to another kind of ground is as unread as a typo.
+    json j = fullScene();
+    j["ground"]["type"] = "plane";
+    j["ground"].erase("radius");
+    j["ground"].erase("centre");
+    expectError(j, "ground.peak", "unknown key");
+}
+
+TEST(SceneParser, MissingRequiredValueIsNamed)
+{
+    for (const auto& [section, key] : std::vector<std::pair<std::string, std::string>>{
+             {"camera", "position"}, {"camera", "look_at"}, {"", "camera"}, {"", "lights"},
+             {"", "trees"}}) {
+        json j = fullScene();
+        (section.empty() ? j : j[section]).erase(key);
+        expectError(j, section.empty() ? key : section + "." + key, "missing");
+    }
+    json j = fullScene();
+    j["trees"][0].erase("species");
+    expectError(j, "trees[0].species", "missing");
+    j = fullScene();
+    j["species"]["fir"]["lsystem"].erase("axiom");
+    expectError(j, "species.fir.lsystem.axiom", "missing");
+    j = fullScene();
+    j["ground"].erase("radius");
+    expectError(j, "ground.radius", "missing");
+}
+
+TEST(SceneParser, MissingKeyPointsAtItsLikelyTypo)
+{
+    json j = fullScene();
+    j["camera"]["positon"] = j["camera"]["position"];
+    j["camera"].erase("position");
+    expectError(j, "camera.position", "\"positon\" a typo");
+}
+
+TEST(SceneParser, RejectsNegativeAndZeroSizes)
+{
+    const std::vector<std::pair<std::vector<std::string>, double>> bad = {
+        {{"trees", "0", "height"}, -5},
+        {{"species", "fir", "lsystem", "segment"}, 0},
+        {{"species", "fir", "lsystem", "trunk_radius"}, -1},
+        {{"species", "fir", "needles", "base", "length"}, -4.25},
+        {{"species", "fir", "needles", "tip", "radius"}, 0},
+        {{"species", "fir", "needles", "base", "cone_spacing"}, -0.9},
+        {{"species", "fir", "needles", "base", "per_cone"}, 0},
+        {{"ground", "radius"}, -300},
+        {{"lights", "0", "intensity"}, -1},
+        {{"trees", "2", "scatter", "min_spacing"}, -1},
+        {{"camera", "fov_deg"}, 180},
+        {{"camera", "fov_deg"}, 0},
+        {{"species", "fir", "needles", "base", "aperture_deg"}, 95},
+        {{"species", "fir", "bark_albedo"}, 1.5},
+        {{"species", "fir", "specular_exponent"}, 1},
+        {{"render", "cone_level_max"}, 0.1},
+    };
+    for (const auto& [place, value] : bad) {
+        json j = fullScene();
+        json* node = &j;
+        std::string path;
+        for (const std::string& step : place) {
+            const bool index = std::isdigit(static_cast<unsigned char>(step[0]));
+            node = index ? &(*node)[std::stoul(step)] : &(*node)[step];
+            path += index ? "[" + step + "]" : (path.empty() ? "" : ".") + step;
+        }
+        *node = value;
+        expectError(j, path, "must");
+    }
+}
+
+TEST(SceneParser, RejectsWrongTypesAndShapes)
+{
+    json j = fullScene();
+    j["camera"]["position"] = {0, 1};
+    expectError(j, "camera.position", "array of 3 numbers");
+    j = fullScene();
+    j["camera"]["fov_deg"] = "wide";
+    expectError(j, "camera.fov_deg", "must be a number");
+    j = fullScene();
+    j["trees"][0]["seed"] = 4.5;
+    expectError(j, "trees[0].seed", "must be an integer (is 4.5)");
+    j["trees"][0]["seed"] = 4.0;  // an integer written as a float is one
+    EXPECT_EQ(parseScene(j.dump(), "s.json").trees[0].seed, 4u);
+    j["trees"][0]["seed"] = "4";
+    expectError(j, "trees[0].seed", "must be an integer, not string");
+    j = fullScene();
+    j["trees"][0]["seed"] = -1;
+    expectError(j, "trees[0].seed", "must be in [0, 4294967295]");
+    j = fullScene();
+    j["trees"][0]["position"] = {1, 2, 3, 4};
+    expectError(j, "trees[0].position", "2 numbers");
+    j = fullScene();
+    j["lights"][0]["type"] = "spot";
+    expectError(j, "lights[0].type", "\"point\" or \"directional\"");
+    j = fullScene();
+    j["ground"]["type"] = "mountain";
+    expectError(j, "ground.type", "\"plane\", \"hill\" or \"none\"");
+    j = fullScene();
+    j["lights"] = json::array();
+    expectError(j, "lights", "at least one light");
+    j = fullScene();
+    j["effects"] = {"diffuse", "shadow"};
+    expectError(j, "effects[1]", "unknown effect \"shadow\"");
+    j = fullScene();
+    j["effects"] = {"diffuse", "diffuse"};
+    expectError(j, "effects[1]", "named twice");
+    j = fullScene();
+    j["trees"][2]["scatter"]["region"] = {{500, 0}, {-500, 10}};
+    expectError(j, "trees[2].scatter.region", "x0 <= x1");
+}
+
+TEST(SceneParser, RejectsUnknownSpecies)
+{
+    json j = fullScene();
+    j["trees"][1]["species"] = "spruce";
+    expectError(j, "trees[1].species", "unknown species \"spruce\" (defined: fir)");
+    j = fullScene();
+    j["trees"][2]["scatter"]["species"] = "pine";
+    expectError(j, "trees[2].scatter.species", "unknown species \"pine\"");
+}
+
+TEST(SceneParser, RejectsZeroVectors)
+{
+    json j = fullScene();
+    j["lights"][1]["direction"] = {0, 0, 0};
+    expectError(j, "lights[1].direction", "zero vector");
+    j = fullScene();
+    j["camera"]["up"] = {0, 0, 0};
+    expectError(j, "camera.up", "zero vector");
+    j = fullScene();
+    j["camera"]["look_at"] = j["camera"]["position"];
+    expectError(j, "camera.look_at", "no view direction");
+    j = fullScene();
+    j["camera"]["up"] = {0, 1, 0};
+    j["camera"]["look_at"] = {1, 0, 120};  // view along +y, parallel to up
+    expectError(j, "camera.up", "parallel to the view direction");
+}
+
+TEST(SceneParser, RejectsZeroResolution)
+{
+    json j = fullScene();
+    j["camera"]["resolution"] = {0, 480};
+    expectError(j, "camera.resolution[0]", "must be in [1, 16384]");
+    j["camera"]["resolution"] = {640, 0};
+    expectError(j, "camera.resolution[1]", "must be in [1, 16384]");
+    j["camera"]["resolution"] = {640};
+    expectError(j, "camera.resolution", "[width, height]");
+}
+
+TEST(SceneParser, RejectsBadLSystems)
+{
+    json j = fullScene();
+    j["species"]["fir"]["lsystem"]["rules"]["B"] = "F$B";
+    expectError(j, "species.fir.lsystem.rules.B", "unknown symbol '$'");
+    j = fullScene();
+    j["species"]["fir"]["lsystem"]["rules"]["B"] = "F[B";
+    expectError(j, "species.fir.lsystem.rules.B", "'[' without its ']'");
+    j = fullScene();
+    j["species"]["fir"]["lsystem"]["axiom"] = "A]";
+    expectError(j, "species.fir.lsystem.axiom", "']' without its '['");
+    j = fullScene();
+    j["species"]["fir"]["lsystem"]["rules"]["AB"] = "F";
+    expectError(j, "species.fir.lsystem.rules.AB", "one letter");
+    // A rule that doubles the string 30 times would need 2^30 symbols: refused before growing.
+    j = fullScene();
+    j["species"]["fir"]["lsystem"]["rules"]["A"] = "AA";
+    j["species"]["fir"]["lsystem"]["iterations"] = 30;
+    expectError(j, "species.fir.lsystem.iterations", "grows past");
+}
+
+TEST(SceneParser, RejectsNeedlesThatCannotExist)
+{
+    json j = fullScene();
+    j["species"]["fir"]["needles"]["base"]["radius"] = 5;
+    expectError(j, "species.fir.needles.base.radius", "less than the needle length");
+    // 40 needles of radius 0.2 cover 2 N r / (pi R) = 3 times their cone.
+    j = fullScene();
+    j["species"]["fir"]["needles"]["tip"]["per_cone"] = 40;
+    j["species"]["fir"]["needles"]["tip"]["radius"] = 0.2;
+    expectError(j, "species.fir.needles.tip", "needles overlap");
+}
+
+TEST(SceneParser, RejectsAHeightForATreeThatGrowsNone)
+{
+    json j = fullScene();
+    j["species"]["flat"] = {{"lsystem", {{"axiom", "[&FF]"}, {"branch_angle_deg", 90},
+                                         {"jitter_deg", 0}, {"iterations", 0}}}};
+    j["trees"][0]["species"] = "flat";
+    expectError(j, "trees[0].height", "grows no height");
+    j["trees"][0]["height"] = 0;  // its own size is fine
+    EXPECT_EQ(errorOf(j), "");
+}
+
+TEST(SceneParser, AcceptsCommentsAsStrings)
+{
+    json j = fullScene();
+    j["comment"] = "why this scene";
+    j["camera"]["comment"] = "why this camera";
+    j["species"]["fir"]["lsystem"]["rules"]["comment"] = "rules explained";
+    EXPECT_EQ(errorOf(j), "");
+    j["camera"]["comment"] = 3;
+    expectError(j, "camera.comment", "must be a string");
+}
+
+TEST(LoadScene, MissingFileSaysSo)
+{
+    const test::TempDir dir;
+    const auto file = dir.path() / "absent.json";
+    try {
+        loadScene(file);
+        FAIL() << "no error for a missing file";
+    } catch (const SceneError& e) {
+        const std::string message = e.what();
+        EXPECT_EQ(message, file.string() + ": cannot open: no such file");
+    }
+    EXPECT_THROW(loadScene(dir.path()), SceneError);  // a folder is no scene
+}
+
+TEST(LoadScene, ReadsAFileAndNamesItInErrors)
+{
+    const test::TempDir dir;
+    const auto good = dir.write("forest-7.json", minimalScene().dump());
+    const Scene s = loadScene(good);
+    EXPECT_EQ(s.name, "forest-7");
+    EXPECT_EQ(s.source, good);
+
+    json bad = minimalScene();
+    bad["camera"]["fov_deg"] = 200;
+    const auto badFile = dir.write("bad.json", bad.dump());
+    try {
+        loadScene(badFile);
+        FAIL() << "fov 200 accepted";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  badFile.string() + ": camera.fov_deg: must be in (0, 180) (is 200)");
+    }
+}
+
+}  // namespace
+}  // namespace pine::scenes

@@ -1,0 +1,120 @@
+// The tracer's geometry: cylinder tests, strip coverage, the BVH against brute force, and the
+// camera's footprint.
+#include "pine/vdbtrace/bvh.h"
+#include "pine/vdbtrace/cone_camera.h"
+#include "pine/vdbtrace/geometry.h"
+#include "pine/vdbtrace/multiscale_tracer.h"
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+namespace pine::vdbtrace {
+namespace {
+
+TEST(Geometry, CylinderIntervalMatchesTheChord)
+{
+    // A ray across the z axis at offset d from it crosses a cylinder of radius r over
+    // 2 sqrt(r^2 - d^2).
+    const Vec3 a(0, 0, -5), b(0, 0, 5);
+    for (const double d : {0.0, 0.3, 0.9}) {
+        ConeRay ray{Vec3(-10, d, 0), Vec3(1, 0, 0), 0.0};
+        double tIn, tOut;
+        ASSERT_TRUE(intersectCylinder(ray, a, b, 1.0, tIn, tOut));
+        EXPECT_NEAR(tOut - tIn, 2 * std::sqrt(1 - d * d), 1e-12);
+        EXPECT_NEAR(0.5 * (tIn + tOut), 10.0, 1e-12);
+        Passage p;
+        ASSERT_TRUE(closestPassage(ray, a, b, p));
+        EXPECT_NEAR(p.t, 10.0, 1e-12);
+        EXPECT_NEAR(p.gap, d, 1e-12);
+        EXPECT_NEAR(p.s, 0.5, 1e-12);
+    }
+    ConeRay miss{Vec3(-10, 1.5, 0), Vec3(1, 0, 0), 0.0};
+    double tIn, tOut;
+    EXPECT_FALSE(intersectCylinder(miss, a, b, 1.0, tIn, tOut));
+    ConeRay aboveCap{Vec3(-10, 0, 6), Vec3(1, 0, 0), 0.0};
+    EXPECT_FALSE(intersectCylinder(aboveCap, a, b, 1.0, tIn, tOut));
+}
+
+TEST(Geometry, StripCoverageIsTheOverlapFraction)
+{
+    EXPECT_DOUBLE_EQ(stripCoverage(0.0, 0.1, 1.0), 0.2);    // thin strip inside the footprint
+    EXPECT_DOUBLE_EQ(stripCoverage(0.0, 2.0, 1.0), 1.0);    // strip wider than the footprint
+    EXPECT_DOUBLE_EQ(stripCoverage(0.5, 0.1, 1.0), 0.1);    // half out on one side
+    EXPECT_DOUBLE_EQ(stripCoverage(0.7, 0.1, 1.0), 0.0);    // out
+    // Sliding a strip across the footprint conserves its area: int coverage d(gap) = 2 h.
+    double sum = 0.0;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) sum += stripCoverage(-1.0 + 2.0 * (i + 0.5) / n, 0.15, 0.5) * 2.0 / n;
+    EXPECT_NEAR(sum, 0.3, 1e-6);
+}
+
+TEST(Bvh, FindsEveryBoxTheConeTouches)
+{
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-50.0, 50.0), r(0.1, 3.0);
+    std::vector<Aabb> boxes(2000);
+    for (Aabb& b : boxes) {
+        const Vec3 c(u(rng), u(rng), u(rng));
+        const double h = r(rng);
+        b.lo = c - Vec3(h);
+        b.hi = c + Vec3(h);
+    }
+    const Bvh bvh(boxes);
+    for (int k = 0; k < 200; ++k) {
+        ConeRay ray{Vec3(u(rng), u(rng), -80.0), glm::normalize(Vec3(0.3 * u(rng) / 50, 0.3 * u(rng) / 50, 1.0)),
+                    0.01};
+        std::set<std::uint32_t> found;
+        bvh.query(ray, 1e9, [&](std::uint32_t i) { found.insert(i); });
+        for (std::uint32_t i = 0; i < boxes.size(); ++i) {
+            // Brute force with the tightest margin the cone needs: its width at the box's far side.
+            double tIn, tOut;
+            const double far = glm::length(boxes[i].centre() - ray.origin) +
+                               0.5 * glm::length(boxes[i].hi - boxes[i].lo);
+            if (intersectBox(ray, boxes[i], 0.5 * ray.width(far), 1e9, tIn, tOut)) {
+                EXPECT_TRUE(found.count(i)) << "box " << i << " missed";
+            }
+        }
+    }
+}
+
+TEST(ConeCamera, FootprintIsOnePixelAtTheCentre)
+{
+    scenes::Camera c;
+    c.position_cm = Vec3(0, 0, 0);
+    c.lookAt_cm = Vec3(0, 1, 0);
+    c.up = Vec3(0, 0, 1);
+    c.fovY_rad = 0.8;
+    c.width = 400;
+    c.height = 300;
+    const ConeCamera camera(c);
+    const ConeRay centre = camera.cone(200, 150);
+    // At distance 1 along the view axis the image plane is 2 tan(fov/2) tall over 300 pixels.
+    EXPECT_NEAR(centre.width(1.0), 2 * std::tan(0.4) / 300, 1e-5);
+    // Neighbouring cones are one footprint apart where they land.
+    const ConeRay next = camera.cone(201, 150);
+    EXPECT_NEAR(glm::length(next.direction - centre.direction), centre.width(1.0), 1e-5);
+    // Row 0 is at the top.
+    EXPECT_GT(camera.cone(200, 0).direction.z, 0.0);
+}
+
+TEST(MultiscaleTracer, LevelFollowsTheFootprintAgainstTheConeSpacing)
+{
+    scenes::RenderSettings s;
+    s.needleLevelMax = 0.25;
+    s.coneLevelMax = 1.0;
+    EXPECT_EQ(chooseLevel(0.1, 0.9, s), Level::Needle);
+    EXPECT_EQ(chooseLevel(0.5, 0.9, s), Level::Cone);
+    EXPECT_EQ(chooseLevel(0.9, 0.9, s), Level::Bough);
+    EXPECT_EQ(chooseLevel(50.0, 0.9, s), Level::Bough);
+    // Halving the spacing (denser boughs) moves the same footprint up a level, never down.
+    for (double w = 0.01; w < 5.0; w *= 1.3) {
+        EXPECT_GE(int(chooseLevel(w, 0.45, s)), int(chooseLevel(w, 0.9, s)));
+    }
+}
+
+}  // namespace
+}  // namespace pine::vdbtrace

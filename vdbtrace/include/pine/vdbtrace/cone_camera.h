@@ -1,0 +1,25 @@
+// The pinhole camera of a scene, one cone per pixel: the pixel's footprint grows with
+// distance by the pixel's angular size (section 3.2: "the conic ray is used to estimate the
+// apparent size of primitives").
+#pragma once
+
+#include "pine/scenes/scene.h"
+#include "pine/vdbtrace/geometry.h"
+
+namespace pine::vdbtrace {
+
+class ConeCamera {
+public:
+    explicit ConeCamera(const scenes::Camera& camera);
+    /// The cone through the centre of pixel (x, y), row 0 at the top.
+    ConeRay cone(int x, int y) const;
+    int width() const { return mWidth; }
+    int height() const { return mHeight; }
+
+private:
+    Vec3 mEye, mForward, mRight, mUp;
+    double mTanHalf = 0.0, mAspect = 1.0;
+    int mWidth = 1, mHeight = 1;
+};
+
+}  // namespace pine::vdbtrace

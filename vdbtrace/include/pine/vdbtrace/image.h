@@ -1,0 +1,66 @@
+// A rendered frame: premultiplied RGBA plus named single-channel AOVs, and how it is written.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace pine::vdbtrace {
+
+/// Linear, premultiplied RGBA in scanline order (row 0 at the top), and AOVs of one float per
+/// pixel each (e.g. "level": coverage-weighted level in [1, 3], 0 where nothing was hit;
+/// "depth": distance in cm to the first hit, 0 where none).
+struct Image {
+    int width = 0, height = 0;
+    std::vector<float> rgba;                         ///< 4 floats per pixel
+    std::map<std::string, std::vector<float>> aovs;  ///< 1 float per pixel each
+
+    Image() = default;
+    Image(int w, int h) : width(w), height(h), rgba(std::size_t(w) * h * 4, 0.0f) {}
+    float* pixel(int x, int y) { return &rgba[(std::size_t(y) * width + x) * 4]; }
+    const float* pixel(int x, int y) const { return &rgba[(std::size_t(y) * width + x) * 4]; }
+    std::vector<float>& aov(const std::string& name)  ///< created zero-filled on first use
+    {
+        auto& v = aovs[name];
+        if (v.empty()) v.assign(std::size_t(width) * height, 0.0f);
+        return v;
+    }
+};
+
+/// Key/value pairs stored in the file's header (render time, scene, method, settings, ...).
+using Metadata = std::vector<std::pair<std::string, std::string>>;
+
+class ImageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/// Fails early (before a long render) if `path` cannot be written: its folder is missing or
+/// not writable. Throws ImageError naming the path.
+void checkWritable(const std::filesystem::path& path);
+
+/// OpenEXR, float: channels R, G, B, A and one channel per AOV named "<aov>.Y" (so that
+/// viewers show each AOV as a layer), metadata as string attributes. Written to a temporary
+/// name in the same folder, then renamed: never half-written. Throws ImageError, also for an
+/// empty or repeated metadata key and for keys that OpenEXR/OIIO interpret themselves
+/// ("compression", "name", "owner", "DateTime", "oiio:*", ...), which would not come back.
+void writeExr(const Image& image, const std::filesystem::path& path, const Metadata& metadata);
+
+/// 8-bit sRGB PNG preview of RGB (alpha composited over black, clamped), atomically.
+void writePng(const Image& image, const std::filesystem::path& path);
+
+/// The paper's Figure 12: each pixel coloured by the coverage-weighted level of the "level"
+/// AOV (red: needle, green: cone, blue: bough, blended between; black where nothing was hit),
+/// as 8-bit PNG, atomically. Throws ImageError if the image has no "level" AOV.
+void writeLevelPng(const Image& image, const std::filesystem::path& path);
+
+/// Reads an EXR written by writeExr back (tests, and `vdbtrace diff` later). `metadata`
+/// receives the string attributes other than OpenEXR/OIIO's own, sorted by key (EXR headers
+/// keep no order). A missing A channel reads as 1. Throws ImageError naming the path.
+Image readExr(const std::filesystem::path& path, Metadata* metadata = nullptr);
+
+}  // namespace pine::vdbtrace

@@ -1,0 +1,78 @@
+// The scene as the tracer sees it: trees grown, their cylinders and boughs flattened into one
+// BVH, lights unified, and everything about a bough that depends only on directions (the
+// cone level's face reflectances, the bough's layer rates and laws) computed once per bough
+// and light, not per pixel.
+#pragma once
+
+#include "pine/analytic/bough_shader.h"
+#include "pine/scenes/scene.h"
+#include "pine/scenes/tree.h"
+#include "pine/vdbtrace/bvh.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace pine::vdbtrace {
+
+struct Light {
+    bool directional = false;
+    Vec3 position_cm{0.0};    ///< point light
+    Vec3 towardsLight{0.0};   ///< directional light, unit
+    Vec3 power{1.0};          ///< colour x intensity (point) or x irradiance (directional)
+    /// Unit direction from p towards the light, its distance (inf if directional) and the
+    /// irradiance on a surface facing it.
+    void at(const Vec3& p, Vec3& direction, double& distance, Vec3& irradiance) const;
+};
+
+struct TracedBranch {
+    Vec3 base_cm, tip_cm;
+    double radius_cm = 0.1;
+    Vec3 albedo{0.25};
+};
+
+/// What a bough looks like from one light with the camera where it is (section 6 inputs).
+struct BoughLighting {
+    analytic::FaceReflectance front, rear;  ///< I^cyl of each face (diffuse, specular)
+    analytic::BoughView view;               ///< layer rates for this view and light
+    analytic::BoughLinearLaw law;           ///< section 6.6 under the linear law, clamped
+    double opacityFromLight = 0.0;          ///< the whole bough's opacity seen from the light
+};
+
+struct TracedBough {
+    Vec3 base_cm, tip_cm, axis;  ///< axis: unit, base to tip; needles point towards the tip
+    double length_cm = 0.0;
+    /// Where the cones end: the last cone's needles reach l cos(phi) past the tip. Cones and
+    /// needles (levels 1-2) are found up to here; the volume (level 3) spans base to tip, which
+    /// holds the same amount of needles (the layered region is that cylinder, sheared).
+    Vec3 conesEnd_cm;
+    analytic::BoughGeometry geometry;  ///< needle parameters at mid-bough (section 3.1)
+    double radius_cm = 0.0;            ///< R = l sin(phi)
+    double layerOpacity = 0.0;         ///< A
+    Vec3 needleAlbedo{0.2};
+    double specularWeight = 0.0;
+    double exponent = 100.0;
+    analytic::FrontRear alpha;            ///< opacity of each half seen from the camera (6.6)
+    unsigned seed = 0;                    ///< drives the needles' azimuths at level 1
+    std::vector<BoughLighting> lighting;  ///< one per light
+};
+
+struct TracedScene {
+    const scenes::Scene* scene = nullptr;
+    std::vector<scenes::Tree> trees;
+    std::vector<Light> lights;
+    std::vector<TracedBranch> branches;  ///< primitive index i < branches.size()
+    std::vector<TracedBough> boughs;     ///< primitive index branches.size() + j
+    Bvh bvh;
+
+    bool isBranch(std::size_t primitive) const { return primitive < branches.size(); }
+    const TracedBough& bough(std::size_t primitive) const
+    {
+        return boughs[primitive - branches.size()];
+    }
+};
+
+/// Grows every tree and prepares the scene for its camera, in parallel. Keeps a pointer to
+/// `scene`, which must outlive the result.
+TracedScene buildTracedScene(const scenes::Scene& scene);
+
+}  // namespace pine::vdbtrace

@@ -1,0 +1,59 @@
+#include "pine/vdbtrace/bvh.h"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <numeric>
+
+namespace pine::vdbtrace {
+
+double Bvh::margin(const ConeRay& ray, const Aabb& box)
+{
+    const double far = glm::length(box.centre() - ray.origin) + 0.5 * glm::length(box.hi - box.lo);
+    return 0.5 * ray.width(far);
+}
+
+Bvh::Bvh(const std::vector<Aabb>& boxes)
+{
+    if (boxes.empty()) return;
+    mIndices.resize(boxes.size());
+    std::iota(mIndices.begin(), mIndices.end(), 0u);
+    mNodes.reserve(2 * boxes.size());
+    mNodes.emplace_back();
+    build(boxes, 0, 0, std::uint32_t(boxes.size()));
+}
+
+// Fills node `node` (already allocated) for mIndices[first, first + count); an inner node's
+// two children are allocated next to each other.
+void Bvh::build(const std::vector<Aabb>& boxes, std::uint32_t node, std::uint32_t first,
+                std::uint32_t count)
+{
+    Aabb box, centres;
+    for (std::uint32_t i = first; i < first + count; ++i) {
+        box.grow(boxes[mIndices[i]]);
+        centres.grow(boxes[mIndices[i]].centre());
+    }
+    mNodes[node].box = box;
+    if (count <= 4) {
+        mNodes[node].first = first;
+        mNodes[node].count = count;
+        return;
+    }
+    const Vec3 extent = centres.hi - centres.lo;
+    const int axis = extent.x > extent.y ? (extent.x > extent.z ? 0 : 2)
+                                         : (extent.y > extent.z ? 1 : 2);
+    const std::uint32_t mid = first + count / 2;
+    std::nth_element(mIndices.begin() + first, mIndices.begin() + mid,
+                     mIndices.begin() + first + count, [&](std::uint32_t a, std::uint32_t b) {
+                         return boxes[a].centre()[axis] < boxes[b].centre()[axis];
+                     });
+    const std::uint32_t left = std::uint32_t(mNodes.size());
+    mNodes.emplace_back();
+    mNodes.emplace_back();
+    mNodes[node].first = left;
+    mNodes[node].count = 0;
+    build(boxes, left, first, mid - first);
+    build(boxes, left + 1, mid, first + count - mid);
+}
+
+}  // namespace pine::vdbtrace

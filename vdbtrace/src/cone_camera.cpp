@@ -1,0 +1,35 @@
+#include "pine/vdbtrace/cone_camera.h"
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+
+namespace pine::vdbtrace {
+
+ConeCamera::ConeCamera(const scenes::Camera& c)
+    : mEye(c.position_cm), mWidth(c.width), mHeight(c.height)
+{
+    mForward = glm::normalize(c.lookAt_cm - c.position_cm);
+    mRight = glm::normalize(glm::cross(mForward, c.up));
+    mUp = glm::cross(mRight, mForward);
+    mTanHalf = std::tan(0.5 * c.fovY_rad);
+    mAspect = double(c.width) / c.height;
+}
+
+ConeRay ConeCamera::cone(int x, int y) const
+{
+    const double sx = (2.0 * (x + 0.5) / mWidth - 1.0) * mTanHalf * mAspect;
+    const double sy = (1.0 - 2.0 * (y + 0.5) / mHeight) * mTanHalf;
+    const Vec3 d = mForward + sx * mRight + sy * mUp;
+    const double len = glm::length(d);
+    ConeRay ray;
+    ray.origin = mEye;
+    ray.direction = d / len;
+    // A pixel spans p = 2 tan(fov/2) / height on the image plane at distance 1 along the view
+    // axis. Off axis, at distance len, it subtends p / len across the radial direction and
+    // p / len^2 along it (seen obliquely): their geometric mean is the footprint's growth.
+    ray.spread = 2.0 * mTanHalf / mHeight / std::pow(len, 1.5);
+    return ray;
+}
+
+}  // namespace pine::vdbtrace

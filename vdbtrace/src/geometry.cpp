@@ -1,0 +1,99 @@
+#include "pine/vdbtrace/geometry.h"
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+
+namespace pine::vdbtrace {
+
+Aabb cylinderBounds(const Vec3& a, const Vec3& b, double radius)
+{
+    Aabb box;
+    box.grow(a);
+    box.grow(b);
+    box.lo -= Vec3(radius);
+    box.hi += Vec3(radius);
+    return box;
+}
+
+bool intersectBox(const ConeRay& ray, const Aabb& box, double margin, double tMax, double& tIn,
+                  double& tOut)
+{
+    double t0 = 0.0, t1 = tMax;
+    for (int i = 0; i < 3; ++i) {
+        const double lo = box.lo[i] - margin, hi = box.hi[i] + margin;
+        const double d = ray.direction[i], o = ray.origin[i];
+        if (std::abs(d) < 1e-300) {
+            if (o < lo || o > hi) return false;
+            continue;
+        }
+        double a = (lo - o) / d, b = (hi - o) / d;
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+        if (t0 > t1) return false;
+    }
+    tIn = t0;
+    tOut = t1;
+    return true;
+}
+
+bool closestPassage(const ConeRay& ray, const Vec3& a, const Vec3& b, Passage& out)
+{
+    const Vec3 axis = b - a;
+    const double length = glm::length(axis);
+    if (!(length > 0.0)) return false;
+    const Vec3 u = axis / length;
+    const Vec3 w0 = ray.origin - a;
+    const double du = glm::dot(ray.direction, u);
+    const double denom = 1.0 - du * du;
+    if (denom < 1e-12) return false;  // parallel: the strip model does not apply
+    const double dw = glm::dot(ray.direction, w0), uw = glm::dot(u, w0);
+    const double t = (du * uw - dw) / denom;
+    const double s = (uw - du * dw) / denom;  // along the segment, in cm
+    if (t < 0.0 || s < 0.0 || s > length) return false;
+    const Vec3 gap = (ray.origin + t * ray.direction) - (a + s * u);
+    out = {t, glm::length(gap), s / length};
+    return true;
+}
+
+bool intersectCylinder(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius,
+                       double& tIn, double& tOut)
+{
+    const Vec3 axis = b - a;
+    const double length = glm::length(axis);
+    if (!(length > 0.0) || !(radius > 0.0)) return false;
+    const Vec3 u = axis / length;
+    // Infinite cylinder: |(o + t d - a) x u| = r.
+    const Vec3 m = ray.origin - a;
+    const Vec3 dp = ray.direction - glm::dot(ray.direction, u) * u;
+    const Vec3 mp = m - glm::dot(m, u) * u;
+    const double A = glm::dot(dp, dp), B = 2.0 * glm::dot(dp, mp), C = glm::dot(mp, mp) - radius * radius;
+    double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
+    if (A > 1e-300) {
+        const double disc = B * B - 4.0 * A * C;
+        if (disc < 0.0) return false;
+        const double q = std::sqrt(disc);
+        t0 = (-B - q) / (2.0 * A);
+        t1 = (-B + q) / (2.0 * A);
+    } else if (C > 0.0) {
+        return false;  // parallel to the axis and outside
+    }
+    // End caps: the slab 0 <= (x - a).u <= length.
+    const double du = glm::dot(ray.direction, u), mu = glm::dot(m, u);
+    if (std::abs(du) > 1e-300) {
+        double s0 = (0.0 - mu) / du, s1 = (length - mu) / du;
+        if (s0 > s1) std::swap(s0, s1);
+        t0 = std::max(t0, s0);
+        t1 = std::min(t1, s1);
+    } else if (mu < 0.0 || mu > length) {
+        return false;
+    }
+    t0 = std::max(t0, 0.0);
+    if (t0 > t1) return false;
+    tIn = t0;
+    tOut = t1;
+    return true;
+}
+
+}  // namespace pine::vdbtrace

@@ -1,0 +1,347 @@
+// Writing and reading frames through OpenImageIO: EXR with AOV layers and metadata, PNG
+// previews, the level map of the paper's Figure 12. Every write goes to a temporary name in
+// the destination folder and is renamed into place, so a crash or an error never leaves a
+// half-written file under the final name (a rename within one folder is atomic on POSIX).
+#include "pine/vdbtrace/image.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string_view>
+#include <system_error>
+
+namespace pine::vdbtrace {
+namespace {
+
+namespace fs = std::filesystem;
+
+// An AOV's channel is "<aov>.Y": viewers (and OpenEXR's layer convention) show each AOV as a
+// single-channel layer.
+constexpr std::string_view kAovSuffix = ".Y";
+
+// OIIO error text may span lines; our errors are one line.
+std::string oneLine(std::string text)
+{
+    while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+    std::string out;
+    for (char c : text) {
+        if (c == '\n') out += "; ";
+        else out += c;
+    }
+    return out.empty() ? std::string("unknown error") : out;
+}
+
+[[noreturn]] void fail(const char* what, const fs::path& path, const std::string& why)
+{
+    throw ImageError(std::string(what) + ": cannot write '" + path.string() + "': " +
+                     oneLine(why));
+}
+
+std::string randomHex()
+{
+    // Seeded from the OS so concurrent writers (several renders into one folder) never pick
+    // the same temporary name.
+    static thread_local std::mt19937_64 engine{(std::uint64_t(std::random_device{}()) << 32) ^
+                                               std::random_device{}()};
+    char buffer[17];
+    std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(engine()));
+    return buffer;
+}
+
+// "<path>.tmp<random><ext>": same folder as the final file (so the rename stays within one
+// file system), and the real extension last because OIIO and viewers go by it.
+fs::path temporaryFor(const fs::path& path)
+{
+    return fs::path(path.string() + ".tmp" + randomHex() + path.extension().string());
+}
+
+void checkShape(const Image& image, const char* what, const fs::path& path)
+{
+    if (image.width <= 0 || image.height <= 0) {
+        fail(what, path, "image size " + std::to_string(image.width) + " x " +
+                             std::to_string(image.height) + " is empty");
+    }
+    const std::size_t pixels = std::size_t(image.width) * std::size_t(image.height);
+    if (image.rgba.size() != pixels * 4) {
+        fail(what, path, "rgba holds " + std::to_string(image.rgba.size()) + " floats, " +
+                             std::to_string(pixels * 4) + " expected");
+    }
+    for (const auto& [name, values] : image.aovs) {
+        if (name.empty()) fail(what, path, "an AOV has an empty name");
+        if (values.size() != pixels) {
+            fail(what, path, "AOV '" + name + "' holds " + std::to_string(values.size()) +
+                                 " floats, " + std::to_string(pixels) + " expected");
+        }
+    }
+}
+
+// Header attributes that OpenEXR or OIIO interpret, rename or drop: user metadata under these
+// names would change the file's meaning (compression, windows, colour space) or not come back
+// from readExr, so writeExr refuses them rather than lose them silently.
+bool isReservedKey(std::string_view key)
+{
+    static constexpr std::string_view kReserved[] = {
+        "compression", "name", "type", "view", "channels", "chromaticities", "dataWindow",
+        "displayWindow", "lineOrder", "pixelAspectRatio", "PixelAspectRatio",
+        "screenWindowCenter", "screenWindowWidth", "tiles", "version", "chunkCount",
+        "capDate", "DateTime", "comments", "owner", "multiView", "tiledesc", "envmap",
+        "worldToCamera", "worldToNDC", "xDensity", "XResolution", "YResolution",
+        "ResolutionUnit", "Orientation", "wrapmodes", "maxSamplesPerPixel",
+    };
+    if (key.starts_with("oiio:") || key.starts_with("openexr:")) return true;
+    return std::find(std::begin(kReserved), std::end(kReserved), key) != std::end(kReserved);
+}
+
+// Standard attributes readExr leaves out of the metadata: OIIO reports them for every EXR
+// (its writer stamps "DateTime" on every file, stored as the EXR attribute capDate).
+bool isStandardAttribute(std::string_view key)
+{
+    return key.starts_with("oiio:") || key.starts_with("openexr:") || key == "compression" ||
+           key == "name" || key == "type" || key == "view" || key == "DateTime";
+}
+
+/// Writes `pixels` (interleaved, `spec.format`) with the OIIO plugin `format` to a temporary
+/// file, then renames it onto `path`. Removes the temporary on any failure.
+void writeAtomically(const char* what, const char* format, const fs::path& path,
+                     const OIIO::ImageSpec& spec, const void* pixels)
+{
+    // Choose the plugin by name, not by the temporary's extension: writeExr("x.img") must
+    // still write OpenEXR.
+    auto out = OIIO::ImageOutput::create(format);
+    if (!out) fail(what, path, OIIO::geterror());
+
+    fs::path temporary = temporaryFor(path);
+    for (int attempt = 0; attempt < 8 && fs::exists(temporary); ++attempt) {
+        temporary = temporaryFor(path);
+    }
+    auto discard = [&](const std::string& why) {
+        std::error_code ignored;
+        fs::remove(temporary, ignored);
+        fail(what, path, why);
+    };
+
+    if (!out->open(temporary.string(), spec)) discard(out->geterror());
+    if (!out->write_image(spec.format, pixels)) {
+        std::string why = out->geterror();
+        out->close();
+        discard(why);
+    }
+    if (!out->close()) discard(out->geterror());
+    out.reset();
+
+    std::error_code error;
+    fs::rename(temporary, path, error);
+    if (error) discard("rename from '" + temporary.string() + "' failed: " + error.message());
+}
+
+std::uint8_t toByte(float value)
+{
+    // NaN and negatives go to 0; written this way because std::clamp passes NaN through.
+    if (!(value > 0.0f)) return 0;
+    if (value >= 1.0f) return 255;
+    return static_cast<std::uint8_t>(std::lround(value * 255.0f));
+}
+
+/// The sRGB transfer function (IEC 61966-2-1) of a linear value, clamped to [0, 1] first.
+float encodeSrgb(float linear)
+{
+    if (!(linear > 0.0f)) return 0.0f;
+    if (linear >= 1.0f) return 1.0f;
+    return linear <= 0.0031308f ? 12.92f * linear
+                                : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+}
+
+/// Figure 12's colour of a coverage-weighted level: 1 red (needle), 2 green (cone), 3 blue
+/// (bough), linear in between; black for 0 (nothing hit) and NaN.
+void levelColour(float level, float rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!(level > 0.0f)) return;
+    const float v = std::clamp(level, 1.0f, 3.0f);
+    if (v <= 2.0f) {
+        rgb[0] = 2.0f - v;
+        rgb[1] = v - 1.0f;
+    } else {
+        rgb[1] = 3.0f - v;
+        rgb[2] = v - 2.0f;
+    }
+}
+
+void writeBytesPng(const char* what, const fs::path& path, int width, int height,
+                   const std::vector<std::uint8_t>& rgb)
+{
+    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:ColorSpace", "sRGB");
+    writeAtomically(what, "png", path, spec, rgb.data());
+}
+
+}  // namespace
+
+void checkWritable(const std::filesystem::path& path)
+{
+    auto refuse = [&](const std::string& why) {
+        throw ImageError("cannot write '" + path.string() + "': " + why);
+    };
+    if (path.empty()) refuse("the path is empty");
+    std::error_code error;
+    if (fs::is_directory(path, error)) refuse("it is a folder");
+    const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    if (!fs::is_directory(folder, error)) refuse("folder '" + folder.string() + "' is missing");
+
+    // Permission bits do not tell the whole story (read-only mounts, ACLs, root): try it.
+    const fs::path probe = folder / (".pine-write-probe-" + randomHex());
+    std::FILE* file = std::fopen(probe.c_str(), "wx");
+    if (!file) {
+        refuse("folder '" + folder.string() + "' is not writable: " + std::strerror(errno));
+    }
+    std::fclose(file);
+    fs::remove(probe, error);
+}
+
+void writeExr(const Image& image, const std::filesystem::path& path, const Metadata& metadata)
+{
+    constexpr const char* what = "writeExr";
+    checkShape(image, what, path);
+
+    const int channels = 4 + int(image.aovs.size());
+    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"R", "G", "B", "A"};
+    for (const auto& entry : image.aovs) {
+        spec.channelnames.push_back(entry.first + std::string(kAovSuffix));
+    }
+    spec.alpha_channel = 3;
+    spec.attribute("compression", "zip");  // lossless: float values come back bit-exact
+    for (std::size_t i = 0; i < metadata.size(); ++i) {
+        const auto& [key, value] = metadata[i];
+        if (key.empty()) fail(what, path, "a metadata key is empty");
+        if (isReservedKey(key)) {
+            fail(what, path, "metadata key '" + key + "' is reserved by OpenEXR/OpenImageIO");
+        }
+        for (std::size_t j = 0; j < i; ++j) {
+            if (metadata[j].first == key) {
+                fail(what, path, "metadata key '" + key + "' is given twice");
+            }
+        }
+        spec.attribute(key, value);
+    }
+
+    const std::size_t pixels = std::size_t(image.width) * std::size_t(image.height);
+    std::vector<float> interleaved(pixels * std::size_t(channels));
+    for (std::size_t p = 0; p < pixels; ++p) {
+        float* out = &interleaved[p * std::size_t(channels)];
+        std::copy_n(&image.rgba[p * 4], 4, out);
+        std::size_t c = 4;
+        for (const auto& entry : image.aovs) out[c++] = entry.second[p];
+    }
+    writeAtomically(what, "openexr", path, spec, interleaved.data());
+}
+
+void writePng(const Image& image, const std::filesystem::path& path)
+{
+    constexpr const char* what = "writePng";
+    checkShape(image, what, path);
+    const std::size_t pixels = std::size_t(image.width) * std::size_t(image.height);
+    std::vector<std::uint8_t> rgb(pixels * 3);
+    for (std::size_t p = 0; p < pixels; ++p) {
+        // Premultiplied RGB over black is RGB itself: alpha is not needed here.
+        for (std::size_t c = 0; c < 3; ++c) {
+            rgb[p * 3 + c] = toByte(encodeSrgb(image.rgba[p * 4 + c]));
+        }
+    }
+    writeBytesPng(what, path, image.width, image.height, rgb);
+}
+
+void writeLevelPng(const Image& image, const std::filesystem::path& path)
+{
+    constexpr const char* what = "writeLevelPng";
+    checkShape(image, what, path);
+    const auto found = image.aovs.find("level");
+    if (found == image.aovs.end()) fail(what, path, "the image has no 'level' AOV");
+
+    const std::size_t pixels = std::size_t(image.width) * std::size_t(image.height);
+    std::vector<std::uint8_t> rgb(pixels * 3);
+    for (std::size_t p = 0; p < pixels; ++p) {
+        float colour[3];
+        levelColour(found->second[p], colour);
+        // Weighted by coverage so that the background stays black, as in Figure 12. The
+        // colours are a false-colour code, not radiance: stored as is, not sRGB-encoded.
+        const float alpha = image.rgba[p * 4 + 3];
+        const float coverage = alpha > 0.0f ? std::min(alpha, 1.0f) : 0.0f;
+        for (std::size_t c = 0; c < 3; ++c) rgb[p * 3 + c] = toByte(colour[c] * coverage);
+    }
+    writeBytesPng(what, path, image.width, image.height, rgb);
+}
+
+Image readExr(const std::filesystem::path& path, Metadata* metadata)
+{
+    auto refuse = [&](const std::string& why) -> Image {
+        throw ImageError("readExr: cannot read '" + path.string() + "': " + oneLine(why));
+    };
+    auto in = OIIO::ImageInput::open(path.string());
+    if (!in) return refuse(OIIO::geterror());
+    if (std::string_view(in->format_name()) != "openexr") {
+        return refuse(std::string("it is ") + in->format_name() + ", not OpenEXR");
+    }
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.depth != 1 || spec.deep) {
+        return refuse("not a flat 2D image");
+    }
+
+    auto channelIndex = [&](const std::string& name) {
+        const auto& names = spec.channelnames;
+        const auto it = std::find(names.begin(), names.end(), name);
+        return it == names.end() ? -1 : int(it - names.begin());
+    };
+    int rgbaIndex[4];
+    const char* rgbaNames[4] = {"R", "G", "B", "A"};
+    for (int c = 0; c < 4; ++c) {
+        rgbaIndex[c] = channelIndex(rgbaNames[c]);
+        if (rgbaIndex[c] < 0 && c < 3) {
+            return refuse(std::string("it has no channel ") + rgbaNames[c]);
+        }
+    }
+
+    const int channels = spec.nchannels;
+    const std::size_t pixels = std::size_t(spec.width) * std::size_t(spec.height);
+    std::vector<float> interleaved(pixels * std::size_t(channels));
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, interleaved.data())) {
+        return refuse(in->geterror());
+    }
+
+    Image image(spec.width, spec.height);
+    for (std::size_t p = 0; p < pixels; ++p) {
+        const float* src = &interleaved[p * std::size_t(channels)];
+        for (int c = 0; c < 4; ++c) {
+            // No alpha channel means fully covered.
+            image.rgba[p * 4 + c] = rgbaIndex[c] < 0 ? 1.0f : src[rgbaIndex[c]];
+        }
+    }
+    for (int c = 0; c < channels; ++c) {
+        const std::string& name = spec.channelnames[c];
+        if (name.size() <= kAovSuffix.size() || !name.ends_with(kAovSuffix)) continue;
+        std::vector<float>& values = image.aov(name.substr(0, name.size() - kAovSuffix.size()));
+        for (std::size_t p = 0; p < pixels; ++p) {
+            values[p] = interleaved[p * std::size_t(channels) + c];
+        }
+    }
+
+    if (metadata) {
+        metadata->clear();
+        for (const auto& attribute : spec.extra_attribs) {
+            const std::string key = attribute.name().string();
+            if (attribute.type() != OIIO::TypeDesc::STRING || isStandardAttribute(key)) continue;
+            metadata->emplace_back(key, attribute.get_string());
+        }
+        // The EXR header keeps no order of its own: sort so results are reproducible.
+        std::sort(metadata->begin(), metadata->end());
+    }
+    return image;
+}
+
+}  // namespace pine::vdbtrace

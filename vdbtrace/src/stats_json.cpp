@@ -1,0 +1,56 @@
+#include "pine/vdbtrace/stats_json.h"
+
+#include "pine/vdbtrace/image.h"
+
+#include <fstream>
+#include <random>
+
+namespace pine::vdbtrace {
+
+nlohmann::json toJson(const RenderStats& s)
+{
+    const char* levels[4] = {"none", "needle", "cone", "bough"};
+    nlohmann::json pixels, seconds;
+    for (int k = 0; k < 4; ++k) {
+        pixels[levels[k]] = s.pixelsPerLevel[k];
+        seconds[levels[k]] = double(s.nanosecondsPerLevel[k]) * 1e-9;
+    }
+    return {{"cone_rays", s.coneRays},
+            {"shadow_rays", s.shadowRays},
+            {"self_shadow_evaluations", s.selfShadowEvaluations},
+            {"hits", {{"needle", s.needleHits},
+                      {"cone", s.coneHits},
+                      {"bough", s.boughHits},
+                      {"branch", s.branchHits},
+                      {"ground", s.groundHits}}},
+            {"evaluations", {{"diffuse", s.diffuseEvaluations}, {"specular", s.specularEvaluations}}},
+            {"pixels_per_level", pixels},
+            {"thread_seconds_per_level", seconds}};
+}
+
+nlohmann::json toJson(const EffectsPlan& p)
+{
+    return {{"diffuse", p.diffuse},
+            {"specular", p.specular},
+            {"shadows", p.shadowRays},
+            {"self_shadowing", p.selfShadowing}};
+}
+
+void writeJsonAtomically(const nlohmann::json& json, const std::filesystem::path& path)
+{
+    const std::filesystem::path tmp =
+        path.string() + ".tmp" + std::to_string(std::random_device{}()) + ".json";
+    {
+        std::ofstream out(tmp);
+        out << json.dump(2) << '\n';
+        out.close();
+        if (!out) {
+            std::error_code ec;
+            std::filesystem::remove(tmp, ec);
+            throw ImageError("cannot write " + path.string());
+        }
+    }
+    std::filesystem::rename(tmp, path);
+}
+
+}  // namespace pine::vdbtrace
