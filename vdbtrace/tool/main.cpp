@@ -221,7 +221,9 @@ int main(int argc, char** argv)
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help
+        std::cerr << "vdbtrace: " << e.what() << " (see --help)\n";  // one line
+        return 2;
     }
     std::unique_ptr<tbb::global_control> limit;
     if (threads > 0) {

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# vdbtrace as a user runs it: exit codes, one-line errors, nothing written on failure, real
+# outputs on success. Usage: vdbtrace_cli_test.sh VDBTRACE SOURCE_DIR
+set -u
+vdbtrace=$1
+src=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+# expect_error NAME STATUS PATTERN -- ARGS...: exits STATUS, one stderr line matching PATTERN.
+expect_error() {
+    local name=$1 status=$2 pattern=$3
+    shift 4
+    "$vdbtrace" "$@" >"$work/out" 2>"$work/err"
+    local got=$?
+    [ "$got" -eq "$status" ] || fail "$name: exit $got, expected $status"
+    [ "$(wc -l <"$work/err")" -eq 1 ] || fail "$name: stderr is not one line: $(cat "$work/err")"
+    grep -q -- "$pattern" "$work/err" || fail "$name: stderr lacks '$pattern': $(cat "$work/err")"
+}
+
+expect_error "missing scene" 2 "missing.json" -- render "$work/missing.json" --out "$work/a.exr"
+printf '{"camera": {' >"$work/broken.json"
+expect_error "malformed scene" 2 "broken.json:1:" -- render "$work/broken.json" --out "$work/a.exr"
+expect_error "unwritable output" 2 "no/such/dir" -- render "$src/scenes/bough.json" --out "$work/no/such/dir/a.exr"
+expect_error "unknown method" 2 "not available" -- render "$src/scenes/bough.json" --method reference --out "$work/a.exr"
+expect_error "bad option" 2 "force-level" -- render "$src/scenes/bough.json" --out "$work/a.exr" --force-level 7
+[ -z "$(ls "$work" | grep -v -e '^out$' -e '^err$' -e '^broken.json$')" ] || fail "failed runs left files: $(ls "$work")"
+
+# An existing output survives a failed render.
+echo keep >"$work/keep.exr"
+"$vdbtrace" render "$work/broken.json" --out "$work/keep.exr" 2>/dev/null
+[ "$(cat "$work/keep.exr")" = keep ] || fail "a failed render overwrote an existing output"
+
+# Success: EXR, PNG preview, level image, stats; one summary line last on stderr.
+"$vdbtrace" render "$src/scenes/bough.json" --out "$work/b.exr" --stats "$work/b.json" --aov level 2>"$work/err" \
+    || fail "render of bough.json failed: $(tail -1 "$work/err")"
+for f in b.exr b.png b.level.png b.json; do [ -s "$work/$f" ] || fail "missing output $f"; done
+tail -1 "$work/err" | grep -q "cone rays" || fail "no summary line: $(tail -1 "$work/err")"
+grep -q '"shadow_rays"' "$work/b.json" || fail "stats lack shadow_rays"
+if command -v oiiotool >/dev/null; then
+    oiiotool --info -v "$work/b.exr" | grep -q "level.Y" || fail "EXR lacks the level AOV"
+fi
+
+"$vdbtrace" --help >/dev/null || fail "--help"
+"$vdbtrace" render --help >/dev/null || fail "render --help"
+
+echo "vdbtrace cli: $failures failed"
+[ "$failures" -eq 0 ]
