@@ -9,6 +9,8 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <vector>
 
 namespace pine::scenes {
 namespace {
@@ -45,6 +47,19 @@ json minimalScene()
       "lights": [{"type": "directional", "direction": [0, 0, 1]}],
       "trees": []
     })");
+}
+
+// Follows `place` (object keys, or array indices written as digits) into `j`, writing the
+// key path the parser reports ("trees[2].scatter") into `path`.
+json* walkTo(json& j, const std::vector<std::string>& place, std::string& path)
+{
+    json* node = &j;
+    for (const std::string& step : place) {
+        const bool index = std::isdigit(static_cast<unsigned char>(step[0]));
+        node = index ? &(*node)[std::stoul(step)] : &(*node)[step];
+        path += index ? "[" + step + "]" : (path.empty() ? "" : ".") + step;
+    }
+    return node;
 }
 
 TEST(SceneParser, MinimalSceneTakesTheHeaderDefaults)
@@ -267,13 +282,8 @@ TEST(SceneParser, RejectsAKeyNobodyReadsAnywhere)
     };
     for (const auto& place : places) {
         json j = fullScene();
-        json* node = &j;
         std::string path;
-        for (const std::string& step : place) {
-            const bool index = std::isdigit(static_cast<unsigned char>(step[0]));
-            node = index ? &(*node)[std::stoul(step)] : &(*node)[step];
-            path += index ? "[" + step + "]" : (path.empty() ? "" : ".") + step;
-        }
+        json* node = walkTo(j, place, path);
         (*node)["colour_typo"] = 1;
         expectError(j, path.empty() ? "colour_typo" : path + ".colour_typo", "unknown key");
     }
@@ -335,13 +345,8 @@ TEST(SceneParser, RejectsNegativeAndZeroSizes)
     };
     for (const auto& [place, value] : bad) {
         json j = fullScene();
-        json* node = &j;
         std::string path;
-        for (const std::string& step : place) {
-            const bool index = std::isdigit(static_cast<unsigned char>(step[0]));
-            node = index ? &(*node)[std::stoul(step)] : &(*node)[step];
-            path += index ? "[" + step + "]" : (path.empty() ? "" : ".") + step;
-        }
+        json* node = walkTo(j, place, path);
         *node = value;
         expectError(j, path, "must");
     }

@@ -16,10 +16,10 @@ ConeCamera::ConeCamera(const scenes::Camera& c)
     mAspect = double(c.width) / c.height;
 }
 
-ConeRay ConeCamera::cone(int x, int y) const
+ConeRay ConeCamera::coneAt(double px, double py, double pixels) const
 {
-    const double sx = (2.0 * (x + 0.5) / mWidth - 1.0) * mTanHalf * mAspect;
-    const double sy = (1.0 - 2.0 * (y + 0.5) / mHeight) * mTanHalf;
+    const double sx = (2.0 * px / mWidth - 1.0) * mTanHalf * mAspect;
+    const double sy = (1.0 - 2.0 * py / mHeight) * mTanHalf;
     const Vec3 d = mForward + sx * mRight + sy * mUp;
     const double len = glm::length(d);
     ConeRay ray;
@@ -28,7 +28,7 @@ ConeRay ConeCamera::cone(int x, int y) const
     // A pixel spans p = 2 tan(fov/2) / height on the image plane at distance 1 along the view
     // axis. Off axis, at distance len, it subtends p / len across the radial direction and
     // p / len^2 along it (seen obliquely): their geometric mean is the footprint's growth.
-    ray.spread = 2.0 * mTanHalf / mHeight / std::pow(len, 1.5);
+    ray.spread = pixels * 2.0 * mTanHalf / mHeight / std::pow(len, 1.5);
     return ray;
 }
 

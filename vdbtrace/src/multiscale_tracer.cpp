@@ -2,6 +2,7 @@
 
 #include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/cone_camera.h"
+#include "pine/vdbtrace/ground_hit.h"
 
 #include <glm/geometric.hpp>
 #include <tbb/parallel_for.h>
@@ -37,51 +38,6 @@ double coneRoll(unsigned seed, long j)
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     z ^= z >> 31;
     return 2.0 * kPi * double(z >> 11) * 0x1.0p-53;
-}
-
-// The ground under a ray: distance to the first hit and the surface normal there.
-bool hitGround(const scenes::Ground& g, const ConeRay& ray, double& t, Vec3& normal)
-{
-    using Kind = scenes::Ground::Kind;
-    if (g.kind == Kind::None) return false;
-    if (g.kind == Kind::Plane) {
-        if (ray.direction.z >= -1e-12) return false;
-        t = (g.height_cm - ray.origin.z) / ray.direction.z;
-        normal = Vec3(0, 0, 1);
-        return t > 0.0;
-    }
-    // Hill: march until the ray is below the surface, then bisect.
-    const auto below = [&](double s) {
-        const Vec3 p = ray.origin + s * ray.direction;
-        return p.z - g.heightAt(p.x, p.y);
-    };
-    const double top = g.height_cm + g.hillPeak_cm;
-    if (ray.origin.z > top && ray.direction.z >= 0.0) return false;
-    const double step = std::max(1.0, 0.05 * g.hillRadius_cm);
-    double a = 0.0, fa = below(a);
-    if (fa <= 0.0) return false;  // the eye is under the ground
-    for (double b = step; b < 1e8; b += step) {
-        const double fb = below(b);
-        if (fb <= 0.0) {
-            for (int i = 0; i < 40; ++i) {
-                const double m = 0.5 * (a + b);
-                (below(m) > 0.0 ? a : b) = m;
-            }
-            t = b;
-            const Vec3 p = ray.origin + t * ray.direction;
-            const double h = 1e-3 * g.hillRadius_cm;
-            const double dx = (g.heightAt(p.x + h, p.y) - g.heightAt(p.x - h, p.y)) / (2 * h);
-            const double dy = (g.heightAt(p.x, p.y + h) - g.heightAt(p.x, p.y - h)) / (2 * h);
-            normal = glm::normalize(Vec3(-dx, -dy, 1.0));
-            return true;
-        }
-        // Past the hill's top going up, or far below it: nothing to hit.
-        const Vec3 p = ray.origin + b * ray.direction;
-        if ((p.z > top && ray.direction.z >= 0.0) || p.z < g.height_cm - 1e4) return false;
-        a = b;
-        fa = fb;
-    }
-    return false;
 }
 
 class PixelTracer {
@@ -460,6 +416,7 @@ RenderStats& RenderStats::operator+=(const RenderStats& o)
     boughHits += o.boughHits;
     branchHits += o.branchHits;
     groundHits += o.groundHits;
+    voxelSpans += o.voxelSpans;
     diffuseEvaluations += o.diffuseEvaluations;
     specularEvaluations += o.specularEvaluations;
     for (int k = 0; k < 4; ++k) {

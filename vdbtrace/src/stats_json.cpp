@@ -23,6 +23,7 @@ nlohmann::json toJson(const RenderStats& s)
                       {"bough", s.boughHits},
                       {"branch", s.branchHits},
                       {"ground", s.groundHits}}},
+            {"voxel_spans", s.voxelSpans},
             {"evaluations", {{"diffuse", s.diffuseEvaluations}, {"specular", s.specularEvaluations}}},
             {"pixels_per_level", pixels},
             {"thread_seconds_per_level", seconds}};

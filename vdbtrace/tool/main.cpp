@@ -2,7 +2,9 @@
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/vdbtrace/image.h"
+#include "pine/vdbtrace/image_diff.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
+#include "pine/vdbtrace/reference_tracer.h"
 #include "pine/vdbtrace/stats_json.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -72,12 +74,18 @@ fs::path besideWith(const fs::path& image, const std::string& suffix)
     return p.string() + suffix;
 }
 
+struct ReferenceSettings {
+    double voxelSize_cm = 0.25;
+    int subpixels = 2;
+};
+
 int render(const fs::path& sceneFile, const std::string& method, const fs::path& out,
-           const fs::path& statsFile, const std::vector<std::string>& aovs, int forceLevel)
+           const fs::path& statsFile, const std::vector<std::string>& aovs, int forceLevel,
+           const ReferenceSettings& reference)
 {
-    if (method != "multiscale") {
+    if (method != "multiscale" && method != "reference") {
         std::cerr << "vdbtrace render: method '" << method
-                  << "' is not available yet (only 'multiscale')\n";
+                  << "' is not available yet (multiscale, reference)\n";
         return 2;
     }
     vdbtrace::checkWritable(out);
@@ -85,9 +93,23 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
     const auto loaded = load(sceneFile);
     std::cerr << "vdbtrace: " << sceneFile.string() << ": " << describe(loaded->scene, loaded->traced)
               << '\n';
-    vdbtrace::RenderOptions options = withProgress("rendering");
-    options.forceLevel = forceLevel;
-    const vdbtrace::RenderResult result = vdbtrace::renderMultiscale(loaded->traced, options);
+    vdbtrace::RenderResult result;
+    if (method == "multiscale") {
+        vdbtrace::RenderOptions options = withProgress("rendering");
+        options.forceLevel = forceLevel;
+        result = vdbtrace::renderMultiscale(loaded->traced, options);
+    } else {
+        std::cerr << "vdbtrace: baking the boughs at " << reference.voxelSize_cm << " cm\n";
+        const auto bakeStart = std::chrono::steady_clock::now();
+        const bake::TreeGrids grids = vdbtrace::bakeScene(loaded->traced, reference.voxelSize_cm);
+        std::cerr << "vdbtrace: " << grids.layerOpacity->activeVoxelCount() << " voxels in "
+                  << std::chrono::duration<double>(std::chrono::steady_clock::now() - bakeStart).count()
+                  << " s\n";
+        vdbtrace::ReferenceOptions options;
+        options.subpixels = reference.subpixels;
+        options.progress = withProgress("rendering").progress;
+        result = vdbtrace::renderReference(loaded->traced, grids, options);
+    }
     std::cerr << '\n';
 
     const auto& s = loaded->scene;
@@ -101,7 +123,12 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
         {"pine:level_thresholds", "needle<" + std::to_string(s.render.needleLevelMax) +
                                       " cone<" + std::to_string(s.render.coneLevelMax) +
                                       " (footprint / cone spacing)"},
-        {"pine:units", "cm"}};
+        {"pine:units", "cm"},
+        {"pine:reference", method == "reference"
+                               ? "voxel " + std::to_string(reference.voxelSize_cm) + " cm, " +
+                                     std::to_string(reference.subpixels * reference.subpixels) +
+                                     " rays per pixel, exact per voxel span"
+                               : "n/a"}};
     vdbtrace::writeExr(result.image, out, metadata);
     // The preview shows the scene's background behind what the cone did not cover.
     vdbtrace::Image preview = result.image;
@@ -124,6 +151,10 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
         j["effects"] = effects;
         j["resolution"] = {s.camera.width, s.camera.height};
         j["threads"] = tbb::this_task_arena::max_concurrency();
+        if (method == "reference") {
+            j["voxel_size_cm"] = reference.voxelSize_cm;
+            j["rays_per_pixel"] = reference.subpixels * reference.subpixels;
+        }
         vdbtrace::writeJsonAtomically(j, statsFile);
     }
     const auto& st = result.stats;
@@ -189,6 +220,28 @@ int bench(const fs::path& sceneFile, bool scaling)
     return 0;
 }
 
+int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double scale)
+{
+    std::error_code ec;
+    fs::create_directories(outDir, ec);
+    vdbtrace::checkWritable(outDir / "error.exr");
+    const vdbtrace::Image image = vdbtrace::readExr(a), reference = vdbtrace::readExr(b);
+    const vdbtrace::ImageErrors errors = vdbtrace::compareImages(image, reference);
+    const double shown = scale > 0.0 ? scale : std::max(errors.maxAbsolute, 1e-12);
+    vdbtrace::writeExr(errors.error, outDir / "error.exr",
+                       {{"pine:image", a.string()}, {"pine:reference", b.string()}});
+    vdbtrace::writeErrorPng(errors, shown, outDir / "error.png");
+    nlohmann::json j = errors.toJson();
+    j["image"] = a.string();
+    j["reference"] = b.string();
+    j["png_scale"] = shown;
+    vdbtrace::writeJsonAtomically(j, outDir / "errors.json");
+    std::cerr << "vdbtrace diff: rmse " << errors.rmse << ", mean relative " << errors.meanRelative
+              << ", max " << errors.maxAbsolute << " -> " << outDir.string()
+              << " (error.exr, error.png scaled 0.." << shown << ", errors.json)\n";
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -204,7 +257,16 @@ int main(int argc, char** argv)
     int forceLevel = 0;
     auto* renderCmd = app.add_subcommand("render", "Render a scene to EXR (+ PNG preview)");
     renderCmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
-    renderCmd->add_option("--method", method, "multiscale (reference and geometry: later)");
+    renderCmd->add_option("--method", method,
+                          "multiscale (closed forms), reference (equation 7 through OpenVDB "
+                          "grids); geometry: later");
+    ReferenceSettings reference;
+    renderCmd->add_option("--voxel-size", reference.voxelSize_cm,
+                          "reference: voxel size of the baked boughs, cm")
+        ->check(CLI::PositiveNumber);
+    renderCmd->add_option("--subpixels", reference.subpixels,
+                          "reference: rays per pixel along each axis (the cone's footprint)")
+        ->check(CLI::Range(1, 16));
     renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")->required();
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
@@ -217,6 +279,15 @@ int main(int argc, char** argv)
     benchCmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
     benchCmd->add_flag("--scaling", scaling,
                        "Also render with N x 2 and dh / 2 (section 7's scaling claim)");
+
+    fs::path diffA, diffB, diffOut;
+    double diffScale = 0.0;
+    auto* diffCmd = app.add_subcommand("diff", "Per-pixel error of IMAGE against REFERENCE");
+    diffCmd->add_option("image", diffA, "EXR to judge")->required()->check(CLI::ExistingFile);
+    diffCmd->add_option("reference", diffB, "EXR taken as right")->required()->check(CLI::ExistingFile);
+    diffCmd->add_option("--out", diffOut, "Folder for error.exr, error.png, errors.json")->required();
+    diffCmd->add_option("--scale", diffScale, "Error shown white in error.png (default: the max)")
+        ->check(CLI::NonNegativeNumber);
 
     try {
         app.parse(argc, argv);
@@ -231,9 +302,15 @@ int main(int argc, char** argv)
                                                       std::size_t(threads));
     }
     try {
-        if (*renderCmd) return render(sceneFile, method, out, statsFile, aovs, forceLevel);
+        if (*renderCmd) {
+            return render(sceneFile, method, out, statsFile, aovs, forceLevel, reference);
+        }
+        if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
         return bench(sceneFile, scaling);
     } catch (const scenes::SceneError& e) {
+        std::cerr << "vdbtrace: " << e.what() << '\n';
+        return 2;
+    } catch (const bake::BakeError& e) {
         std::cerr << "vdbtrace: " << e.what() << '\n';
         return 2;
     } catch (const vdbtrace::ImageError& e) {

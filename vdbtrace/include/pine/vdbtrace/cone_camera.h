@@ -12,7 +12,10 @@ class ConeCamera {
 public:
     explicit ConeCamera(const scenes::Camera& camera);
     /// The cone through the centre of pixel (x, y), row 0 at the top.
-    ConeRay cone(int x, int y) const;
+    ConeRay cone(int x, int y) const { return coneAt(x + 0.5, y + 0.5, 1.0); }
+    /// The cone through image point (px, py) in pixel units (0..width, 0..height), as wide as
+    /// `pixels` pixels: a sub-pixel ray is a narrower cone.
+    ConeRay coneAt(double px, double py, double pixels) const;
     int width() const { return mWidth; }
     int height() const { return mHeight; }
 

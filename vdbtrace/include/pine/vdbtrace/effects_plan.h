@@ -33,6 +33,7 @@ struct RenderStats {
     std::uint64_t boughHits = 0;        ///< level 3: boughs shaded as volumes
     std::uint64_t branchHits = 0;
     std::uint64_t groundHits = 0;
+    std::uint64_t voxelSpans = 0;       ///< reference method: voxel spans integrated
     std::uint64_t diffuseEvaluations = 0;
     std::uint64_t specularEvaluations = 0;
     std::uint64_t pixelsPerLevel[4] = {0, 0, 0, 0};  ///< by the level covering most: 0 = none

@@ -1,0 +1,237 @@
+// Voxelizing a tree's boughs: each bough over the cylinder that holds its cones, boughs in
+// parallel into per-thread grids, merged, then every kept voxel filled from its bough.
+#include "pine/bake/tree_grids.h"
+
+#include "density_pyramid.h"
+#include "prepared_bough.h"
+
+#include <openvdb/tools/Composite.h>
+#include <openvdb/tools/Prune.h>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+namespace pine::bake {
+
+namespace {
+
+using detail::PreparedBough;
+
+/// Which bough a voxel keeps, as one integer so that per-thread grids merge by a plain max
+/// (tools::compMax) and the result does not depend on how boughs were split among threads:
+/// the larger mean extinction wins (high word: the float's bits, ordered as the floats are for
+/// positive values), and of equal ones the bough listed first (low word: ~index).
+std::int64_t voxelKey(double meanExtinction, std::size_t bough)
+{
+    const auto bits = std::bit_cast<std::uint32_t>(float(meanExtinction));
+    const auto low = std::uint32_t(0xFFFFFFFFu - std::uint32_t(bough));
+    return std::int64_t((std::uint64_t(bits) << 32) | low);
+}
+
+std::size_t boughOfKey(std::int64_t key)
+{
+    return std::size_t(0xFFFFFFFFu - std::uint32_t(std::uint64_t(key) & 0xFFFFFFFFu));
+}
+
+/// World position of voxel ijk's centre: the same as Transform::createLinearTransform(h)
+/// ->indexToWorld(ijk), which multiplies index by voxel size.
+Vec3 voxelCentre(const openvdb::Coord& ijk, double h)
+{
+    return Vec3(double(ijk.x()) * h, double(ijk.y()) * h, double(ijk.z()) * h);
+}
+
+/// Interval [lo, hi] of z (world cm) on the vertical line through (x, y) that lies inside the
+/// cylinder holding the bough's region; empty when lo > hi.
+struct Interval {
+    double lo, hi;
+};
+
+Interval columnInside(const PreparedBough& b, double x, double y, Interval bounds)
+{
+    const Vec3& a = b.axis();
+    const Vec3 c(x - b.base().x, y - b.base().y, -b.base().z);  // q(z) = c + z e_z, from base
+    const double ca = c.x * a.x + c.y * a.y + c.z * a.z;
+    // Distance to the axis line: |q|^2 - (q.a)^2 <= R^2, a quadratic in z.
+    const double a2 = 1.0 - a.z * a.z;
+    const double b1 = c.z - ca * a.z;
+    const double c0 = c.x * c.x + c.y * c.y + c.z * c.z - ca * ca - b.radius_cm() * b.radius_cm();
+    Interval in = bounds;
+    if (a2 > 1e-12) {
+        const double disc = b1 * b1 - a2 * c0;
+        if (disc < 0.0) return {1.0, 0.0};
+        const double root = std::sqrt(disc);
+        in.lo = std::max(in.lo, (-b1 - root) / a2);
+        in.hi = std::min(in.hi, (-b1 + root) / a2);
+    } else if (c0 > 0.0) {
+        return {1.0, 0.0};
+    }
+    // Along the axis: 0 <= q.a = ca + z a_z <= extent.
+    if (std::abs(a.z) > 1e-12) {
+        double z0 = -ca / a.z, z1 = (b.extent_cm() - ca) / a.z;
+        if (z0 > z1) std::swap(z0, z1);
+        in.lo = std::max(in.lo, z0);
+        in.hi = std::min(in.hi, z1);
+    } else if (ca < 0.0 || ca > b.extent_cm()) {
+        return {1.0, 0.0};
+    }
+    return in;
+}
+
+/// Writes the keys of one bough's voxels, keeping larger keys already there.
+void voxelizeBough(const PreparedBough& b, std::size_t index, double h,
+                   openvdb::Int64Grid::Accessor& keys)
+{
+    if (b.empty()) return;
+    const Vec3 p0 = b.base(), p1 = b.base() + b.extent_cm() * b.axis();
+    const Vec3& a = b.axis();
+    Vec3 lo, hi;
+    for (int i = 0; i < 3; ++i) {
+        // A cylinder's extent along a world axis: its ends, widened by R sin(angle to axis).
+        const double widen = b.radius_cm() * std::sqrt(std::max(0.0, 1.0 - a[i] * a[i]));
+        lo[i] = std::min(p0[i], p1[i]) - widen;
+        hi[i] = std::max(p0[i], p1[i]) + widen;
+    }
+    const auto first = [h](double v) { return int(std::ceil(v / h)) - 1; };
+    const auto last = [h](double v) { return int(std::floor(v / h)) + 1; };
+    for (int i = first(lo.x); i <= last(hi.x); ++i) {
+        for (int j = first(lo.y); j <= last(hi.y); ++j) {
+            const Interval z = columnInside(b, double(i) * h, double(j) * h, {lo.z, hi.z});
+            if (z.lo > z.hi) continue;
+            // One voxel of slack on each side: the exact test is sample()'s.
+            for (int k = first(z.lo); k <= last(z.hi); ++k) {
+                const openvdb::Coord ijk(i, j, k);
+                const auto s = b.sample(voxelCentre(ijk, h));
+                if (!s) continue;
+                const double mean = s->meanExtinction();
+                if (!(mean > 0.0)) continue;
+                const std::int64_t key = voxelKey(mean, index);
+                if (key > keys.getValue(ijk)) keys.setValue(ijk, key);
+            }
+        }
+    }
+}
+
+openvdb::Int64Grid::Ptr voxelKeys(const std::vector<PreparedBough>& boughs, double h)
+{
+    tbb::enumerable_thread_specific<openvdb::Int64Grid::Ptr> partial(
+        [] { return openvdb::Int64Grid::create(0); });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, boughs.size(), 4),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          auto keys = partial.local()->getAccessor();
+                          for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                              voxelizeBough(boughs[b], b, h, keys);
+                          }
+                      });
+    openvdb::Int64Grid::Ptr merged = openvdb::Int64Grid::create(0);
+    for (auto& grid : partial) openvdb::tools::compMax(*merged, *grid);
+    return merged;
+}
+
+template <class GridT>
+typename GridT::Ptr makeGrid(const char* name, const openvdb::math::Transform::Ptr& xform)
+{
+    auto grid = GridT::create(typename GridT::ValueType(0));
+    grid->setName(name);
+    grid->setTransform(xform);
+    return grid;
+}
+
+}  // namespace
+
+TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& settings)
+{
+    openvdb::initialize();
+    const double h = settings.voxelSize_cm;
+    if (!(std::isfinite(h) && h > 0.0)) {
+        throw BakeError("bake: voxel size must be finite and > 0, got " + std::to_string(h));
+    }
+    if (settings.pyramidLevels < 1 || settings.pyramidLevels > 16) {
+        throw BakeError("bake: pyramid levels must be in [1, 16], got " +
+                        std::to_string(settings.pyramidLevels));
+    }
+    if (boughs.size() >= 0xFFFFFFFFu) throw BakeError("bake: too many boughs");
+    std::vector<PreparedBough> prepared;
+    prepared.reserve(boughs.size());
+    for (std::size_t i = 0; i < boughs.size(); ++i) {
+        prepared.emplace_back(boughs[i]);
+        if (const char* why = prepared.back().invalidReason()) {
+            throw BakeError("bake: bough " + std::to_string(i) + ": " + why);
+        }
+    }
+
+    const openvdb::Int64Grid::Ptr keys = voxelKeys(prepared, h);
+
+    TreeGrids out;
+    out.voxelSize_cm = h;
+    const auto xform = openvdb::math::Transform::createLinearTransform(h);
+    out.density = makeGrid<openvdb::FloatGrid>(grid_names::kDensity, xform);
+    out.layerGradient = makeGrid<openvdb::Vec3SGrid>(grid_names::kLayerGradient, xform);
+    out.layerOpacity = makeGrid<openvdb::FloatGrid>(grid_names::kLayerOpacity, xform);
+    out.needleDirection = makeGrid<openvdb::Vec3SGrid>(grid_names::kNeedleDirection, xform);
+    out.needleAlbedo = makeGrid<openvdb::Vec3SGrid>(grid_names::kNeedleAlbedo, xform);
+    out.density->setGridClass(openvdb::GRID_FOG_VOLUME);
+    // How a tool must transform the vectors with the grid: G = grad g / dh is a gradient
+    // (covariant: by the inverse transpose), the needle a direction (contravariant), the
+    // albedo a colour (invariant). All are in world space.
+    out.layerGradient->setVectorType(openvdb::VEC_COVARIANT);
+    out.needleDirection->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+    out.needleAlbedo->setVectorType(openvdb::VEC_INVARIANT);
+    for (const auto& grid : {out.layerGradient, out.needleDirection, out.needleAlbedo}) {
+        grid->setIsInWorldSpace(true);
+    }
+
+    // Each kept voxel, filled from its bough at the voxel's centre.
+    auto density = out.density->getAccessor();
+    auto gradient = out.layerGradient->getAccessor();
+    auto opacity = out.layerOpacity->getAccessor();
+    auto needle = out.needleDirection->getAccessor();
+    auto albedo = out.needleAlbedo->getAccessor();
+    double maxMean = 0.0;
+    for (auto it = keys->cbeginValueOn(); it; ++it) {
+        const openvdb::Coord ijk = it.getCoord();
+        const std::size_t b = boughOfKey(*it);
+        const auto s = prepared[b].sample(voxelCentre(ijk, h));
+        if (!s) continue;  // cannot happen: the key was written from this very sample
+        const auto vec = [](const Vec3& v) {
+            return openvdb::Vec3s(float(v.x), float(v.y), float(v.z));
+        };
+        const double mean = s->meanExtinction();
+        maxMean = std::max(maxMean, mean);
+        density.setValue(ijk, float(mean));
+        gradient.setValue(ijk, vec(s->gradient));
+        opacity.setValue(ijk, float(s->layerOpacity));
+        needle.setValue(ijk, vec(s->needle));
+        albedo.setValue(ijk, vec(boughs[b].needleAlbedo));
+    }
+
+    // The fog-volume class wants [0, 1] (DESIGN.md): store density / max with the max apart.
+    out.densityScale_per_cm = maxMean;
+    if (maxMean > 0.0) {
+        const float inv = float(1.0 / maxMean);
+        for (auto it = out.density->beginValueOn(); it; ++it) {
+            it.setValue(std::min(*it * inv, 1.0f));
+        }
+    }
+    openvdb::tools::prune(out.density->tree());
+    openvdb::tools::prune(out.layerOpacity->tree());
+    openvdb::tools::prune(out.needleAlbedo->tree());
+
+    openvdb::FloatGrid::Ptr previous = out.density;
+    for (int level = 1; level < settings.pyramidLevels; ++level) {
+        openvdb::FloatGrid::Ptr coarse = detail::halveResolution(*previous);
+        coarse->setName(std::string(grid_names::kDensity) + "_lod" + std::to_string(level));
+        coarse->setGridClass(openvdb::GRID_FOG_VOLUME);
+        openvdb::tools::prune(coarse->tree());
+        out.densityPyramid.push_back(coarse);
+        previous = coarse;
+    }
+    return out;
+}
+
+}  // namespace pine::bake

@@ -1,0 +1,35 @@
+#include "density_pyramid.h"
+
+#include <algorithm>
+
+namespace pine::bake::detail {
+
+openvdb::FloatGrid::Ptr halveResolution(const openvdb::FloatGrid& fine)
+{
+    openvdb::math::Transform::Ptr xform = fine.transform().copy();
+    // The children's fine centres, 2I + {0, 1}, average to 2I + 1/2: coarse index I maps to
+    // fine index 2I + 1/2 (each pre-operation acts on the index before what was there).
+    xform->preTranslate(openvdb::Vec3d(0.5));
+    xform->preScale(2.0);
+
+    auto coarse = openvdb::FloatGrid::create(0.0f);
+    coarse->setTransform(xform);
+    auto acc = coarse->getAccessor();
+    for (auto it = fine.cbeginValueOn(); it; ++it) {
+        // A tile (pruned constant region) stands for all its voxels.
+        openvdb::CoordBBox box;
+        it.getBoundingBox(box);
+        const float v = *it * 0.125f;
+        for (auto ijk = box.begin(); ijk; ++ijk) {
+            // Arithmetic shift: floor division by 2, right for negative indices too.
+            const openvdb::Coord c((*ijk).x() >> 1, (*ijk).y() >> 1, (*ijk).z() >> 1);
+            acc.setValue(c, acc.getValue(c) + v);
+        }
+    }
+    // Eight float terms of at most 1/8 each may round past 1 by an ulp; the fog class wants
+    // [0, 1].
+    for (auto it = coarse->beginValueOn(); it; ++it) it.setValue(std::min(*it, 1.0f));
+    return coarse;
+}
+
+}  // namespace pine::bake::detail

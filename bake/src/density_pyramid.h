@@ -1,0 +1,18 @@
+// Coarser levels of a density grid, for tools and tracers that want a cheaper proxy far away.
+// Private to bake/.
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+namespace pine::bake::detail {
+
+/// The grid at twice the voxel size: each voxel the mean of its 2 x 2 x 2 children, absent
+/// children counting as 0 (empty space), so the mass (sum of density x voxel volume) is kept
+/// exactly and values stay in [0, 1]. Coarse voxel I covers fine voxels 2I + {0, 1}^3, so its
+/// centre is their mean centre: the transform is scaled by 2 and shifted by half a fine voxel.
+/// Written here, not with tools::MultiResGrid: that one is vertex-centred (coarse voxel I sits
+/// on fine voxel 2I) and restricts by full weighting over 27 neighbours, which blurs and moves
+/// the mass; here a coarse voxel is exactly the cell its children fill.
+openvdb::FloatGrid::Ptr halveResolution(const openvdb::FloatGrid& fine);
+
+}  // namespace pine::bake::detail

@@ -1,0 +1,105 @@
+// The bough's layer field (paper section 6) on the true cones (docs/errata.md, E12).
+#include "pine/bake/layer_field.h"
+
+#include "prepared_bough.h"
+
+#include "pine/analytic/cone_shader.h"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pine::bake {
+
+double LayerSample::layerExtinction() const
+{
+    // log1p keeps the digits of a thin layer (A << 1), where -ln(1 - A) ~ A.
+    return std::min(-std::log1p(-std::clamp(layerOpacity, 0.0, 1.0)), kMaxLayerExtinction);
+}
+
+double LayerSample::extinction(const Vec3& d) const
+{
+    return layerExtinction() * std::abs(glm::dot(d, gradient));
+}
+
+double LayerSample::meanExtinction() const
+{
+    // The mean of |d . G| over the unit sphere is |G| / 2: with u = cos(d, G) uniform on
+    // [-1, 1], E|u| = 1/2.
+    return layerExtinction() * glm::length(gradient) * 0.5;
+}
+
+std::optional<LayerSample> sampleBough(const BoughSpec& bough, const Vec3& x_cm)
+{
+    return detail::PreparedBough(bough).sample(x_cm);
+}
+
+namespace detail {
+
+namespace {
+
+bool finite(const Vec3& v)
+{
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+}  // namespace
+
+PreparedBough::PreparedBough(const BoughSpec& spec)
+{
+    const double phi = spec.aperture_rad;
+    if (!finite(spec.base_cm) || !finite(spec.tip_cm) || !finite(spec.needleAlbedo) ||
+        !std::isfinite(phi) || !std::isfinite(spec.needleLength_cm) ||
+        !std::isfinite(spec.needleRadius_cm) || !std::isfinite(spec.needlesPerCone) ||
+        !std::isfinite(spec.coneSpacing_cm)) {
+        mInvalid = "a parameter is not finite";
+    } else if (!(phi > 0.0 && phi <= analytic::kPi / 2)) {
+        mInvalid = "aperture_rad must be in (0, pi/2]";
+    } else if (spec.needleLength_cm < 0.0 || spec.needleRadius_cm < 0.0 ||
+               spec.needlesPerCone < 0.0) {
+        mInvalid = "needle length, radius and count must be >= 0";
+    } else if (!(spec.coneSpacing_cm > 0.0)) {
+        mInvalid = "coneSpacing_cm must be > 0";
+    }
+    if (mInvalid) return;
+
+    const analytic::ConeGeometry cone{phi, spec.needleLength_cm, spec.needleRadius_cm,
+                                      spec.needlesPerCone};
+    mBase = spec.base_cm;
+    mLength = glm::length(spec.tip_cm - spec.base_cm);
+    mRadius = analytic::boughRadius(cone);      // R = l sin(phi)
+    mOpacity = analytic::layerOpacity(cone);    // A = 2 N r / (pi R), in [0, 1]
+    mCosPhi = std::cos(phi);
+    mSinPhi = std::sin(phi);
+    mCotPhi = mCosPhi / mSinPhi;
+    mInvSpacing = 1.0 / spec.coneSpacing_cm;
+    if (mLength > 0.0) mAxis = (spec.tip_cm - spec.base_cm) / mLength;
+    mEmpty = !(mLength > 0.0 && mRadius > 0.0 && mOpacity > 0.0 && std::isfinite(mAxis.x));
+}
+
+std::optional<LayerSample> PreparedBough::sample(const Vec3& x_cm) const
+{
+    if (mEmpty) return std::nullopt;
+    const Vec3 v = x_cm - mBase;
+    const double h = glm::dot(v, mAxis);
+    const Vec3 across = v - h * mAxis;
+    const double rho = glm::length(across);
+    // On the axis every cone has its apex and the radial direction is undefined.
+    if (!(rho >= 1e-9) || rho > mRadius) return std::nullopt;
+    // g = h - rho cot(phi) is the height of the apex of the cone through x: the cones' apexes
+    // lie on the branch, between its base and its tip.
+    const double g = h - rho * mCotPhi;
+    if (g < 0.0 || g > mLength) return std::nullopt;
+
+    const Vec3 radial = across / rho;
+    LayerSample s;
+    s.gradient = (mAxis - mCotPhi * radial) * mInvSpacing;  // grad g / dh
+    s.needle = mCosPhi * mAxis + mSinPhi * radial;
+    s.layerOpacity = mOpacity;
+    return s;
+}
+
+}  // namespace detail
+
+}  // namespace pine::bake

@@ -1,0 +1,44 @@
+// The manifest beside each baked file (`PATH.json`): its name, size and FNV-1a 64 checksum, so
+// that a reader refuses a damaged or foreign file before OpenVDB parses it (a damaged .vdb can
+// crash OpenVDB 10.0.1: DESIGN.md). Private to bake/.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace pine::bake::detail {
+
+/// FNV-1a, 64 bits: not cryptographic; it detects damage, not forgery.
+class Fnv1a64 {
+public:
+    void update(std::string_view bytes);
+    std::uint64_t value() const { return mHash; }
+    static std::string hex(std::uint64_t hash);  ///< 16 lower-case digits
+
+private:
+    std::uint64_t mHash = 14695981039346656037ull;
+};
+
+struct FileDigest {
+    std::uintmax_t bytes = 0;
+    std::uint64_t fnv1a64 = 0;
+};
+
+/// Size and checksum of a file, read in chunks. Throws BakeError.
+FileDigest digestFile(const std::filesystem::path& file);
+
+std::filesystem::path manifestPath(const std::filesystem::path& file);
+
+/// Writes `file`'s manifest atomically (temporary file, then rename). Throws BakeError.
+void writeManifest(const std::filesystem::path& file, const FileDigest& digest);
+
+/// The bytes of `file`, once its manifest is found and its size and checksum match it.
+/// Throws BakeError "'FILE' does not match its manifest (written by bake?): WHY".
+std::string readVerified(const std::filesystem::path& file);
+
+/// A name for a temporary file beside `file`, in the same folder so that rename is atomic.
+std::filesystem::path temporaryBeside(const std::filesystem::path& file);
+
+}  // namespace pine::bake::detail

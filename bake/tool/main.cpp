@@ -1,0 +1,177 @@
+// bake: voxelize a scene's trees into OpenVDB grids (one .vdb and its manifest per tree).
+#include "pine/bake/tree_boughs.h"
+#include "pine/bake/tree_grids.h"
+#include "pine/scenes/scene.h"
+#include "pine/scenes/tree.h"
+
+#include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <sys/resource.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <mutex>
+
+namespace {
+
+using namespace pine;
+namespace fs = std::filesystem;
+
+double peakMemoryMiB()
+{
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
+
+/// Set once a progress line is on stderr without its newline: an error then starts a new line.
+std::atomic<bool> gProgressOpen{false};
+
+struct Totals {
+    std::atomic<std::size_t> trees{0};
+    std::atomic<std::uint64_t> voxels{0}, bytes{0};
+};
+
+/// Grows tree `index` of the scene, bakes it and writes it to `out`.
+void bakeTree(const scenes::Scene& scene, const fs::path& sceneFile, std::size_t index,
+              const bake::BakeSettings& settings, const fs::path& out, Totals& totals)
+{
+    const scenes::TreePlacement& placement = scene.trees[index];
+    const scenes::Tree tree = scenes::growTree(scene.species.at(placement.species), placement);
+    const bake::TreeGrids grids = bake::bakeBoughs(bake::treeBoughs(tree), settings);
+    bake::writeTreeGrids(grids, out, {sceneFile.string(), int(index), placement.seed});
+    totals.trees += 1;
+    totals.voxels += grids.density->activeVoxelCount();
+    totals.bytes += std::uint64_t(fs::file_size(out));
+}
+
+void summarize(const Totals& totals, std::chrono::steady_clock::time_point start)
+{
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "bake: %zu trees, %llu voxels, %llu bytes, %.2f s, peak %.0f MiB\n",
+                 totals.trees.load(), static_cast<unsigned long long>(totals.voxels.load()),
+                 static_cast<unsigned long long>(totals.bytes.load()), seconds, peakMemoryMiB());
+}
+
+int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& settings,
+            const fs::path& out)
+{
+    const auto start = std::chrono::steady_clock::now();
+    bake::checkWritable(out);  // before the work, not after it
+    const scenes::Scene scene = scenes::loadScene(sceneFile);
+    if (tree < 0 || std::size_t(tree) >= scene.trees.size()) {
+        std::cerr << "bake: " << sceneFile.string() << ": no tree " << tree << " (the scene has "
+                  << scene.trees.size() << ")\n";
+        return 2;
+    }
+    Totals totals;
+    bakeTree(scene, sceneFile, std::size_t(tree), settings, out, totals);
+    summarize(totals, start);
+    return 0;
+}
+
+fs::path treeFile(const fs::path& dir, std::size_t index)
+{
+    char name[32];
+    std::snprintf(name, sizeof name, "tree_%03zu.vdb", index);
+    return dir / name;
+}
+
+int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& settings, const fs::path& dir)
+{
+    const auto start = std::chrono::steady_clock::now();
+    bake::checkWritable(treeFile(dir, 0));
+    const scenes::Scene scene = scenes::loadScene(sceneFile);
+    const std::size_t n = scene.trees.size();
+    Totals totals;
+    std::mutex progress;
+    // Trees in parallel, one task each; bakeBoughs also splits a tree's boughs among threads.
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+        bakeTree(scene, sceneFile, i, settings, treeFile(dir, i), totals);
+        const std::lock_guard<std::mutex> lock(progress);
+        std::fprintf(stderr, "\rbake: %zu/%zu trees", totals.trees.load(), n);
+        std::fflush(stderr);
+        gProgressOpen = true;
+    });
+    if (gProgressOpen.exchange(false)) std::fputc('\n', stderr);
+    summarize(totals, start);
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"bake: voxelize the boughs of a scene's trees into OpenVDB grids (density, "
+                 "layer gradient and opacity, needle direction and albedo)"};
+    app.require_subcommand(1);
+    int threads = 0;
+    app.add_option("--threads", threads, "Worker threads (default: all cores)")
+        ->check(CLI::NonNegativeNumber);
+
+    fs::path sceneFile, out, outDir;
+    int tree = 0;
+    bake::BakeSettings settings;
+    // CLI::PositiveNumber would print DBL_MAX in its message.
+    const CLI::Validator positive(
+        [](std::string& text) -> std::string {
+            try {
+                const double v = std::stod(text);
+                if (std::isfinite(v) && v > 0.0) return {};
+            } catch (const std::exception&) {
+            }
+            return "must be a number > 0, got '" + text + "'";
+        },
+        "> 0");
+    const auto addCommon = [&](CLI::App* cmd) {
+        cmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
+        cmd->add_option("--voxel-size", settings.voxelSize_cm, "Voxel size in cm")
+            ->required()
+            ->check(positive);
+        cmd->add_option("--levels", settings.pyramidLevels,
+                        "Density levels at h, 2h, 4h, ... (1: no pyramid)")
+            ->default_val(settings.pyramidLevels)
+            ->check(CLI::Range(1, 16));
+    };
+    auto* treeCmd = app.add_subcommand("tree", "Bake one tree of a scene into one .vdb");
+    addCommon(treeCmd);
+    treeCmd->add_option("--tree", tree, "Index of the tree in the scene (from 0)")->required();
+    treeCmd->add_option("--out", out, "Output .vdb; its manifest goes to OUT.json")->required();
+
+    auto* sceneCmd = app.add_subcommand("scene", "Bake every tree: DIR/tree_000.vdb, ...");
+    addCommon(sceneCmd);
+    sceneCmd->add_option("--out-dir", outDir, "Existing output folder")->required();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help
+        std::cerr << "bake: " << e.what() << " (see --help)\n";  // one line
+        return 2;
+    }
+    std::unique_ptr<tbb::global_control> limit;
+    if (threads > 0) {
+        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                      std::size_t(threads));
+    }
+    try {
+        if (*treeCmd) return bakeOne(sceneFile, tree, settings, out);
+        return bakeScene(sceneFile, settings, outDir);
+    } catch (const scenes::SceneError& e) {
+        std::cerr << "bake: " << e.what() << '\n';
+        return 2;
+    } catch (const bake::BakeError& e) {
+        std::cerr << (gProgressOpen ? "\n" : "") << "bake: " << e.what() << '\n';
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << (gProgressOpen ? "\n" : "") << "bake: " << e.what() << '\n';
+        return 1;
+    }
+}

@@ -1,0 +1,245 @@
+// Voxelized boughs against the continuous field: mass, values at voxel centres, the overlap
+// rule, the density pyramid.
+#include "pine/bake/tree_grids.h"
+
+#include "test_support.h"
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace pine::bake {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Sum over active values (voxels and tiles) of value x its volume in index units.
+double indexSum(const openvdb::FloatGrid& grid)
+{
+    double sum = 0.0;
+    for (auto it = grid.cbeginValueOn(); it; ++it) {
+        sum += double(*it) * double(it.getVoxelCount());
+    }
+    return sum;
+}
+
+/// Sum over voxels of mean extinction x h^3: the voxelized "mass", per cm^0 (optical depth
+/// x area).
+double voxelizedMass(const TreeGrids& g)
+{
+    return indexSum(*g.density) * g.densityScale_per_cm * std::pow(g.voxelSize_cm, 3);
+}
+
+TEST(BakeBoughs, MassOfALongBoughMatchesTheIntegral)
+{
+    // The region {rho <= R, 0 <= h - rho cot(phi) <= L} is a cylinder sheared along its axis:
+    // volume pi R^2 L; the mean extinction is uniform in it, mu |G| / 2 with |G| =
+    // 1 / (dh sin(phi)). So sum(mean extinction x h^3) must be mu / (2 dh sin(phi)) pi R^2 L.
+    //
+    // Tolerance: counting voxel centres in a body errs only in the cells its surface cuts, all
+    // within sqrt(3) h / 2 of it, so |error| <= sqrt(3) h S / V relative (first order in h / R),
+    // with S / V = 2 / R (side) + 2 / (L sin(phi)) (the end cones, pi R^2 / sin(phi) each).
+    // That bound assumes every cut cell errs the same way; a systematic error does (a layer of
+    // boundary voxels dropped or added costs ~ h S / V = bound / sqrt(3)), while a correct
+    // count's cut cells gain and lose alike and cancel: measured, the error is ~1% of the bound.
+    // So each error must stay under bound / 10, and the mean over sub-voxel shifts of the bough
+    // must shrink with h. The axis is oblique so that no face lines up with the voxels.
+    const BoughSpec b = test::paperBough(Vec3(0.3, -0.7, 0.1), Vec3(0.3, 0.5, 0.8), 60.0);
+    const double phi = b.aperture_rad, R = b.needleLength_cm * std::sin(phi), L = 60.0;
+    const double A = 2.0 * b.needlesPerCone * b.needleRadius_cm / (kPi * R);
+    const double mu = -std::log(1.0 - A);
+    const double exact = mu / (2.0 * b.coneSpacing_cm * std::sin(phi)) * kPi * R * R * L;
+    const double surfaceOverVolume = 2.0 / R + 2.0 / (L * std::sin(phi));
+
+    double previousMean = 0.0;
+    for (const double h : {R / 4, R / 8, R / 16}) {
+        const double bound = std::sqrt(3.0) * h * surfaceOverVolume;
+        constexpr int kShifts = 8;
+        double sumError = 0.0;
+        for (int k = 0; k < kShifts; ++k) {
+            // Sub-voxel shifts of the bough: a deterministic low-discrepancy set.
+            const Vec3 shift = h * Vec3(std::fmod(0.5 + k * 0.618034, 1.0),
+                                        std::fmod(0.5 + k * 0.754878, 1.0),
+                                        std::fmod(0.5 + k * 0.569840, 1.0));
+            BoughSpec shifted = b;
+            shifted.base_cm += shift;
+            shifted.tip_cm += shift;
+            const TreeGrids g = bakeBoughs({shifted}, BakeSettings{h, 1});
+            const double error = std::abs(voxelizedMass(g) / exact - 1.0);
+            EXPECT_LT(error, bound / 10) << "h " << h << ", shift " << k;
+            sumError += error;
+        }
+        const double mean = sumError / kShifts;
+        if (previousMean > 0.0) {
+            EXPECT_LT(mean, previousMean) << "h " << h;
+        }
+        previousMean = mean;
+    }
+}
+
+/// Index box around a bough's region (its cones' reach), widened by one voxel.
+openvdb::CoordBBox searchBox(const BoughSpec& b, double h)
+{
+    const double R = b.needleLength_cm * std::sin(b.aperture_rad);
+    const Vec3 axis = glm::normalize(b.tip_cm - b.base_cm);
+    const Vec3 end = b.tip_cm + axis * (R / std::tan(b.aperture_rad));
+    openvdb::CoordBBox box;
+    for (const Vec3& p : {b.base_cm, end}) {
+        for (const double dx : {-R, R}) {
+            for (const double dy : {-R, R}) {
+                for (const double dz : {-R, R}) {
+                    box.expand(openvdb::Coord(int(std::floor((p.x + dx) / h)),
+                                              int(std::floor((p.y + dy) / h)),
+                                              int(std::floor((p.z + dz) / h))));
+                }
+            }
+        }
+    }
+    box.expand(1);
+    return box;
+}
+
+TEST(BakeBoughs, EveryVoxelSamplesTheFieldAtItsCentre)
+{
+    // Every voxel of the box around the bough: active exactly where the field exists at the
+    // voxel's centre, indexToWorld(ijk) = ijk h, with the field's values there. Catches a
+    // voxel dropped by the voxelizer's column bounds as much as a half-voxel shift.
+    const BoughSpec b = test::paperBough(Vec3(-2.1, 3.4, 0.7), Vec3(-0.6, 0.2, 0.7), 12.0);
+    const double h = 0.35;
+    const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 1});
+    ASSERT_GT(g.densityScale_per_cm, 0.0);
+    EXPECT_EQ(g.voxelSize_cm, h);
+    const auto& xform = g.density->transform();
+    EXPECT_EQ(g.layerOpacity->transform(), xform);
+    EXPECT_EQ(g.layerGradient->transform(), xform);
+    EXPECT_EQ(g.needleDirection->transform(), xform);
+    EXPECT_EQ(g.needleAlbedo->transform(), xform);
+
+    auto density = g.density->getConstAccessor();
+    auto gradient = g.layerGradient->getConstAccessor();
+    auto opacity = g.layerOpacity->getConstAccessor();
+    auto needle = g.needleDirection->getConstAccessor();
+    auto albedo = g.needleAlbedo->getConstAccessor();
+    int inside = 0;
+    const openvdb::CoordBBox box = searchBox(b, h);
+    for (auto it = box.begin(); it; ++it) {
+        const openvdb::Coord ijk = *it;
+        const openvdb::Vec3d w = xform.indexToWorld(ijk);
+        ASSERT_EQ(w, openvdb::Vec3d(ijk.x() * h, ijk.y() * h, ijk.z() * h));
+        const auto s = sampleBough(b, Vec3(w.x(), w.y(), w.z()));
+        ASSERT_EQ(bool(s), density.isValueOn(ijk)) << ijk;
+        if (!s) continue;
+        ++inside;
+        // One bough: its density is uniform, so every voxel holds the maximum, 1.
+        EXPECT_NEAR(density.getValue(ijk) * g.densityScale_per_cm, s->meanExtinction(),
+                    1e-6 * s->meanExtinction());
+        const auto near = [](const openvdb::Vec3s& a, const Vec3& e) {
+            return std::abs(a.x() - e.x) < 1e-6 && std::abs(a.y() - e.y) < 1e-6 &&
+                   std::abs(a.z() - e.z) < 1e-6;
+        };
+        EXPECT_TRUE(near(gradient.getValue(ijk), s->gradient)) << ijk;
+        EXPECT_TRUE(near(needle.getValue(ijk), s->needle)) << ijk;
+        EXPECT_TRUE(near(albedo.getValue(ijk), b.needleAlbedo)) << ijk;
+        EXPECT_NEAR(opacity.getValue(ijk), s->layerOpacity, 1e-7);
+    }
+    EXPECT_GT(inside, 1000);
+}
+
+TEST(BakeBoughs, OverlapKeepsTheDensestBoughWhateverTheOrder)
+{
+    // Two boughs crossing at right angles, the second denser (more needles per cone): where
+    // both reach, the voxel holds the denser one, whichever is listed first.
+    const BoughSpec thin = test::paperBough(Vec3(-8.0, 0.0, 0.0), Vec3(1, 0, 0), 16.0);
+    BoughSpec dense = test::paperBough(Vec3(0.0, -8.0, 0.3), Vec3(0, 1, 0), 16.0);
+    dense.needlesPerCone = 24;
+    dense.needleAlbedo = Vec3(0.5);
+    const BakeSettings settings{0.3, 1};
+    const TreeGrids ab = bakeBoughs({thin, dense}, settings);
+    const TreeGrids ba = bakeBoughs({dense, thin}, settings);
+    EXPECT_EQ(ab.densityScale_per_cm, ba.densityScale_per_cm);
+    ASSERT_EQ(ab.density->activeVoxelCount(), ba.density->activeVoxelCount());
+    auto a = ab.needleAlbedo->getConstAccessor();
+    auto b = ba.needleAlbedo->getConstAccessor();
+    auto da = ab.density->getConstAccessor();
+    auto db = ba.density->getConstAccessor();
+    int overlap = 0;
+    for (auto it = ab.density->cbeginValueOn(); it; ++it) {
+        const openvdb::Coord ijk = it.getCoord();
+        const openvdb::Vec3d w = ab.density->indexToWorld(ijk);
+        const Vec3 x(w.x(), w.y(), w.z());
+        const bool both = sampleBough(thin, x) && sampleBough(dense, x);
+        overlap += both;
+        EXPECT_EQ(da.getValue(ijk), db.getValue(ijk)) << ijk;
+        EXPECT_EQ(a.getValue(ijk), b.getValue(ijk)) << ijk;
+        if (both) {
+            EXPECT_EQ(a.getValue(ijk), openvdb::Vec3s(0.5f)) << ijk;
+        }
+    }
+    EXPECT_GT(overlap, 50);
+}
+
+TEST(BakeBoughs, PyramidLevelsAverageTheirChildrenAndKeepTheMass)
+{
+    const BoughSpec b = test::paperBough(Vec3(1.1, -0.4, 2.0), Vec3(0.2, 0.9, 0.3), 20.0);
+    const double h = 0.25;
+    const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 3});
+    ASSERT_EQ(g.densityPyramid.size(), 2u);
+    const openvdb::FloatGrid* fine = g.density.get();
+    for (std::size_t level = 0; level < 2; ++level) {
+        const openvdb::FloatGrid& coarse = *g.densityPyramid[level];
+        EXPECT_EQ(coarse.getName(), "density_lod" + std::to_string(level + 1));
+        EXPECT_EQ(coarse.getGridClass(), openvdb::GRID_FOG_VOLUME);
+        EXPECT_NEAR(coarse.voxelSize()[0], 2.0 * fine->voxelSize()[0], 1e-12);
+        // Mass: each level is the mean of 8 children at 8 times the volume.
+        EXPECT_NEAR(indexSum(coarse) * 8.0, indexSum(*fine), 1e-5 * indexSum(*fine));
+        auto f = fine->getConstAccessor();
+        for (auto it = coarse.cbeginValueOn(); it; ++it) {
+            const openvdb::Coord c = it.getCoord();
+            float sum = 0.0f;
+            openvdb::Vec3d centre(0.0);
+            for (int i = 0; i < 8; ++i) {
+                const openvdb::Coord child(2 * c.x() + (i & 1), 2 * c.y() + ((i >> 1) & 1),
+                                           2 * c.z() + ((i >> 2) & 1));
+                sum += f.getValue(child);
+                centre += fine->indexToWorld(child) / 8.0;
+            }
+            ASSERT_NEAR(*it, sum / 8.0f, 1e-6f) << c;
+            ASSERT_LE(*it, 1.0f);
+            // The coarse voxel's centre is its children's.
+            ASSERT_TRUE((coarse.indexToWorld(c) - centre).length() < 1e-9) << c;
+        }
+        fine = &coarse;
+    }
+}
+
+TEST(BakeBoughs, RejectsWhatItCannotBake)
+{
+    const BoughSpec b = test::paperBough(Vec3(0.0), Vec3(0, 0, 1), 5.0);
+    EXPECT_THROW(bakeBoughs({b}, BakeSettings{0.0, 1}), BakeError);
+    EXPECT_THROW(bakeBoughs({b}, BakeSettings{std::nan(""), 1}), BakeError);
+    EXPECT_THROW(bakeBoughs({b}, BakeSettings{0.5, 0}), BakeError);
+    BoughSpec bad = b;
+    bad.aperture_rad = 2.0;
+    EXPECT_THROW(bakeBoughs({b, bad}, BakeSettings{0.5, 1}), BakeError);
+    bad = b;
+    bad.tip_cm.x = INFINITY;
+    EXPECT_THROW(bakeBoughs({bad}, BakeSettings{0.5, 1}), BakeError);
+}
+
+TEST(BakeBoughs, NothingToBakeGivesEmptyGrids)
+{
+    BoughSpec zero = test::paperBough(Vec3(0.0), Vec3(0, 0, 1), 5.0);
+    zero.tip_cm = zero.base_cm;
+    for (const auto& boughs : {std::vector<BoughSpec>{}, std::vector<BoughSpec>{zero}}) {
+        const TreeGrids g = bakeBoughs(boughs, BakeSettings{0.5, 3});
+        ASSERT_TRUE(g.density && g.layerGradient && g.layerOpacity && g.needleDirection &&
+                    g.needleAlbedo);
+        EXPECT_EQ(g.density->activeVoxelCount(), 0u);
+        EXPECT_EQ(g.densityScale_per_cm, 0.0);
+        EXPECT_EQ(g.densityPyramid.size(), 2u);
+    }
+}
+
+}  // namespace
+}  // namespace pine::bake

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# bake as a user runs it: exit codes, one-line errors, nothing written on failure, real
+# outputs on success. Usage: bake_cli_test.sh BAKE SOURCE_DIR
+set -u
+bake=$1
+src=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+# expect_error NAME STATUS PATTERN -- ARGS...: exits STATUS, one stderr line matching PATTERN.
+expect_error() {
+    local name=$1 status=$2 pattern=$3
+    shift 4
+    "$bake" "$@" >"$work/out" 2>"$work/err"
+    local got=$?
+    [ "$got" -eq "$status" ] || fail "$name: exit $got, expected $status"
+    [ "$(wc -l <"$work/err")" -eq 1 ] || fail "$name: stderr is not one line: $(cat "$work/err")"
+    grep -q -- "$pattern" "$work/err" || fail "$name: stderr lacks '$pattern': $(cat "$work/err")"
+}
+
+bough=$src/scenes/bough.json
+expect_error "missing scene" 2 "missing.json" -- tree "$work/missing.json" --tree 0 --voxel-size 1 --out "$work/a.vdb"
+printf '{"camera": {' >"$work/broken.json"
+expect_error "malformed scene" 2 "broken.json:1:" -- tree "$work/broken.json" --tree 0 --voxel-size 1 --out "$work/a.vdb"
+expect_error "malformed scene, all trees" 2 "broken.json:1:" -- scene "$work/broken.json" --voxel-size 1 --out-dir "$work"
+expect_error "unwritable output" 2 "no/such/dir" -- tree "$bough" --tree 0 --voxel-size 1 --out "$work/no/such/dir/a.vdb"
+expect_error "missing output folder" 2 "no/such/dir" -- scene "$bough" --voxel-size 1 --out-dir "$work/no/such/dir"
+# The output is checked before the scene is read, and before any work.
+expect_error "unwritable output, bad scene" 2 "no/such/dir" -- tree "$work/broken.json" --tree 0 --voxel-size 1 --out "$work/no/such/dir/a.vdb"
+expect_error "no such tree" 2 "no tree 5" -- tree "$bough" --tree 5 --voxel-size 1 --out "$work/a.vdb"
+expect_error "zero voxel size" 2 "voxel-size" -- tree "$bough" --tree 0 --voxel-size 0 --out "$work/a.vdb"
+expect_error "negative voxel size" 2 "voxel-size" -- scene "$bough" --voxel-size -1 --out-dir "$work"
+expect_error "bad levels" 2 "levels" -- tree "$bough" --tree 0 --voxel-size 1 --levels 0 --out "$work/a.vdb"
+expect_error "missing option" 2 "out" -- tree "$bough" --tree 0 --voxel-size 1
+expect_error "no subcommand" 2 "subcommand" --
+[ -z "$(ls -A "$work" | grep -v -e '^out$' -e '^err$' -e '^broken.json$')" ] || fail "failed runs left files: $(ls -A "$work")"
+
+# One tree: the .vdb and its manifest; one summary line.
+"$bake" tree "$bough" --tree 0 --voxel-size 0.5 --out "$work/b.vdb" 2>"$work/err" \
+    || fail "bake tree of bough.json failed: $(tail -1 "$work/err")"
+for f in b.vdb b.vdb.json; do [ -s "$work/$f" ] || fail "missing output $f"; done
+[ "$(wc -l <"$work/err")" -eq 1 ] || fail "bake tree: stderr is not one line: $(cat "$work/err")"
+grep -q "1 trees, [1-9][0-9]* voxels, [1-9][0-9]* bytes" "$work/err" || fail "no summary line: $(cat "$work/err")"
+grep -q '"fnv1a64"' "$work/b.vdb.json" || fail "manifest lacks fnv1a64"
+
+# All trees of a scene, in parallel: tree_000.vdb ... and a summary line last.
+mkdir "$work/forest"
+"$bake" scene "$src/scenes/three-firs.json" --voxel-size 2 --levels 2 --out-dir "$work/forest" 2>"$work/err" \
+    || fail "bake scene of three-firs.json failed: $(tail -1 "$work/err")"
+for f in tree_000.vdb tree_000.vdb.json tree_002.vdb tree_002.vdb.json; do
+    [ -s "$work/forest/$f" ] || fail "missing output forest/$f"
+done
+[ "$(ls -A "$work/forest" | grep -c '\.vdb$')" -eq 3 ] || fail "expected 3 trees: $(ls -A "$work/forest")"
+[ -z "$(ls -A "$work/forest" | grep -v -e '\.vdb$' -e '\.vdb\.json$')" ] || fail "temporary files left: $(ls -A "$work/forest")"
+tail -1 "$work/err" | grep -q "3 trees, .* voxels, .* bytes, .* s, peak .* MiB" || fail "no summary line: $(tail -1 "$work/err")"
+if command -v vdb_print >/dev/null; then
+    vdb_print "$work/forest/tree_001.vdb" | grep -q "density_lod1" || fail "vdb_print lacks density_lod1"
+fi
+
+"$bake" --help >/dev/null || fail "--help"
+"$bake" tree --help >/dev/null || fail "tree --help"
+"$bake" scene --help >/dev/null || fail "scene --help"
+
+echo "bake cli: $failures failed"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,29 @@
+// `vdbtrace diff`: how far an image is from a reference, per pixel and overall.
+#pragma once
+
+#include "pine/vdbtrace/image.h"
+
+#include <nlohmann/json.hpp>
+
+namespace pine::vdbtrace {
+
+/// Errors of `image` against `reference` (same size), on linear luminance of premultiplied RGB.
+struct ImageErrors {
+    Image error;             ///< RGB: |image - reference| per channel; AOV "error": luminance
+    double rmse = 0.0;       ///< root mean square luminance error over all pixels
+    double meanRelative = 0.0;  ///< mean |e| / reference over pixels where reference > floor
+    double maxAbsolute = 0.0;
+    double relativeFloor = 0.0;  ///< 1% of the reference's mean luminance
+    std::size_t pixels = 0, relativePixels = 0;
+    nlohmann::json toJson() const;
+};
+
+/// Throws ImageError if the sizes differ.
+ImageErrors compareImages(const Image& image, const Image& reference);
+
+/// False colours (black - blue - green - yellow - white) of the luminance error from 0 to
+/// `scale`, with a colour bar along the bottom (0 at the left, `scale` at the right; the scale is
+/// also in the file's metadata), as 8-bit PNG, atomically.
+void writeErrorPng(const ImageErrors& errors, double scale, const std::filesystem::path& path);
+
+}  // namespace pine::vdbtrace

@@ -1,0 +1,98 @@
+#include "pine/vdbtrace/image_diff.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pine::vdbtrace {
+namespace {
+
+double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+
+// A perceptually ordered ramp: black, blue, green, yellow, white at 0, .25, .5, .75, 1.
+void ramp(double v, float* rgb)
+{
+    static const float stops[5][3] = {{0, 0, 0}, {0.1f, 0.2f, 1}, {0.1f, 0.8f, 0.2f}, {1, 0.9f, 0.1f}, {1, 1, 1}};
+    v = std::clamp(v, 0.0, 1.0) * 4.0;
+    const int i = std::min(3, int(v));
+    const double f = v - i;
+    for (int c = 0; c < 3; ++c) rgb[c] = float((1 - f) * stops[i][c] + f * stops[i + 1][c]);
+}
+
+}  // namespace
+
+nlohmann::json ImageErrors::toJson() const
+{
+    return {{"rmse", rmse},
+            {"mean_relative", meanRelative},
+            {"max_absolute", maxAbsolute},
+            {"relative_floor", relativeFloor},
+            {"pixels", pixels},
+            {"relative_pixels", relativePixels},
+            {"quantity", "linear luminance of premultiplied RGB"}};
+}
+
+ImageErrors compareImages(const Image& image, const Image& reference)
+{
+    if (image.width != reference.width || image.height != reference.height) {
+        throw ImageError("images differ in size: " + std::to_string(image.width) + "x" +
+                         std::to_string(image.height) + " against " +
+                         std::to_string(reference.width) + "x" + std::to_string(reference.height));
+    }
+    ImageErrors e;
+    e.error = Image(image.width, image.height);
+    auto& lum = e.error.aov("error");
+    double meanRef = 0.0, sumSq = 0.0;
+    const std::size_t n = std::size_t(image.width) * image.height;
+    for (std::size_t i = 0; i < n; ++i) meanRef += luminance(&reference.rgba[4 * i]);
+    meanRef /= double(std::max<std::size_t>(n, 1));
+    e.relativeFloor = 0.01 * meanRef;
+    double sumRelative = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const float* a = &image.rgba[4 * i];
+        const float* b = &reference.rgba[4 * i];
+        float* out = &e.error.rgba[4 * i];
+        for (int c = 0; c < 3; ++c) out[c] = std::abs(a[c] - b[c]);
+        out[3] = 1.0f;
+        const double ref = luminance(b), d = std::abs(luminance(a) - ref);
+        lum[i] = float(d);
+        sumSq += d * d;
+        e.maxAbsolute = std::max(e.maxAbsolute, d);
+        if (ref > e.relativeFloor && ref > 0.0) {
+            sumRelative += d / ref;
+            ++e.relativePixels;
+        }
+    }
+    e.pixels = n;
+    e.rmse = std::sqrt(sumSq / double(std::max<std::size_t>(n, 1)));
+    e.meanRelative = e.relativePixels ? sumRelative / double(e.relativePixels) : 0.0;
+    return e;
+}
+
+void writeErrorPng(const ImageErrors& errors, double scale, const std::filesystem::path& path)
+{
+    const Image& src = errors.error;
+    const int bar = std::max(8, src.height / 20);
+    Image out(src.width, src.height + bar);
+    const auto& lum = src.aovs.at("error");
+    for (int y = 0; y < src.height; ++y) {
+        for (int x = 0; x < src.width; ++x) {
+            const double v = scale > 0.0 ? lum[std::size_t(y) * src.width + x] / scale : 0.0;
+            ramp(v, out.pixel(x, y));
+            out.pixel(x, y)[3] = 1.0f;
+        }
+    }
+    for (int y = src.height; y < src.height + bar; ++y) {
+        for (int x = 0; x < src.width; ++x) {
+            ramp(double(x) / std::max(1, src.width - 1), out.pixel(x, y));
+            out.pixel(x, y)[3] = 1.0f;
+        }
+    }
+    // The ramp's colours are a code, not light: the PNG writer encodes sRGB, so undo that here
+    // by writing the linear values that encode to the ramp's.
+    for (float& v : out.rgba) {
+        v = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+    }
+    writePng(out, path);
+}
+
+}  // namespace pine::vdbtrace
