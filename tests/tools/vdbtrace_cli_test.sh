@@ -43,6 +43,20 @@ if command -v oiiotool >/dev/null; then
     oiiotool --info -v "$work/b.exr" | grep -q "level.Y" || fail "EXR lacks the level AOV"
 fi
 
+# The reference method reads what bake wrote, and refuses a damaged file with one line.
+bake="$(dirname "$vdbtrace")/bake"
+if [ -x "$bake" ]; then
+    "$bake" tree "$src/scenes/bough.json" --tree 0 --voxel-size 0.5 --out "$work/t.vdb" 2>/dev/null \
+        || fail "bake tree failed"
+    "$vdbtrace" render "$src/scenes/bough.json" --method reference --grids "$work/t.vdb" \
+        --subpixels 1 --out "$work/r.exr" 2>"$work/err" || fail "reference from grids: $(tail -1 "$work/err")"
+    [ -s "$work/r.exr" ] || fail "reference wrote no image"
+    head -c 1000 "$work/t.vdb" >"$work/cut.vdb" && cp "$work/t.vdb.json" "$work/cut.vdb.json"
+    expect_error "damaged grids" 2 "manifest" -- render "$src/scenes/bough.json" --method reference \
+        --grids "$work/cut.vdb" --out "$work/d.exr"
+    [ ! -e "$work/d.exr" ] || fail "a refused render wrote its image"
+fi
+
 "$vdbtrace" --help >/dev/null || fail "--help"
 "$vdbtrace" render --help >/dev/null || fail "render --help"
 

@@ -22,7 +22,16 @@ void ramp(double v, float* rgb)
 
 nlohmann::json ImageErrors::toJson() const
 {
+    nlohmann::json levels;
+    const char* names[4] = {"none", "needle", "cone", "bough"};
+    for (std::size_t k = 0; k < byLevel.size(); ++k) {
+        levels[names[k]] = {{"rmse", byLevel[k].rmse},
+                            {"mean_relative", byLevel[k].meanRelative},
+                            {"pixels", byLevel[k].pixels},
+                            {"relative_pixels", byLevel[k].relativePixels}};
+    }
     return {{"rmse", rmse},
+            {"by_level", levels},
             {"mean_relative", meanRelative},
             {"max_absolute", maxAbsolute},
             {"relative_floor", relativeFloor},
@@ -47,6 +56,10 @@ ImageErrors compareImages(const Image& image, const Image& reference)
     meanRef /= double(std::max<std::size_t>(n, 1));
     e.relativeFloor = 0.01 * meanRef;
     double sumRelative = 0.0;
+    const auto levelAov = image.aovs.find("level");
+    const bool hasLevels = levelAov != image.aovs.end() && levelAov->second.size() == n;
+    std::vector<double> levelSq(4, 0.0), levelRel(4, 0.0);
+    if (hasLevels) e.byLevel.resize(4);
     for (std::size_t i = 0; i < n; ++i) {
         const float* a = &image.rgba[4 * i];
         const float* b = &reference.rgba[4 * i];
@@ -57,10 +70,25 @@ ImageErrors compareImages(const Image& image, const Image& reference)
         lum[i] = float(d);
         sumSq += d * d;
         e.maxAbsolute = std::max(e.maxAbsolute, d);
-        if (ref > e.relativeFloor && ref > 0.0) {
+        const bool relative = ref > e.relativeFloor && ref > 0.0;
+        if (relative) {
             sumRelative += d / ref;
             ++e.relativePixels;
         }
+        if (hasLevels) {
+            const int k = std::clamp(int(std::lround(levelAov->second[i])), 0, 3);
+            levelSq[k] += d * d;
+            ++e.byLevel[k].pixels;
+            if (relative) {
+                levelRel[k] += d / ref;
+                ++e.byLevel[k].relativePixels;
+            }
+        }
+    }
+    for (std::size_t k = 0; k < e.byLevel.size(); ++k) {
+        auto& l = e.byLevel[k];
+        l.rmse = l.pixels ? std::sqrt(levelSq[k] / double(l.pixels)) : 0.0;
+        l.meanRelative = l.relativePixels ? levelRel[k] / double(l.relativePixels) : 0.0;
     }
     e.pixels = n;
     e.rmse = std::sqrt(sumSq / double(std::max<std::size_t>(n, 1)));

@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace {
@@ -77,6 +78,7 @@ fs::path besideWith(const fs::path& image, const std::string& suffix)
 struct ReferenceSettings {
     double voxelSize_cm = 0.25;
     int subpixels = 2;
+    std::vector<fs::path> grids;  ///< baked .vdb files; empty: bake the scene in memory
 };
 
 int render(const fs::path& sceneFile, const std::string& method, const fs::path& out,
@@ -90,6 +92,14 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
     }
     vdbtrace::checkWritable(out);
     if (!statsFile.empty()) vdbtrace::checkWritable(statsFile);
+    // Baked files first: a damaged one is refused before any work.
+    const auto readStart = std::chrono::steady_clock::now();
+    std::optional<bake::TreeGrids> baked;
+    if (method == "reference" && !reference.grids.empty()) {
+        std::vector<bake::TreeGrids> trees;
+        for (const fs::path& file : reference.grids) trees.push_back(bake::readTreeGrids(file));
+        baked = bake::mergeTreeGrids(trees);
+    }
     const auto loaded = load(sceneFile);
     std::cerr << "vdbtrace: " << sceneFile.string() << ": " << describe(loaded->scene, loaded->traced)
               << '\n';
@@ -99,11 +109,16 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
         options.forceLevel = forceLevel;
         result = vdbtrace::renderMultiscale(loaded->traced, options);
     } else {
-        std::cerr << "vdbtrace: baking the boughs at " << reference.voxelSize_cm << " cm\n";
-        const auto bakeStart = std::chrono::steady_clock::now();
-        const bake::TreeGrids grids = vdbtrace::bakeScene(loaded->traced, reference.voxelSize_cm);
-        std::cerr << "vdbtrace: " << grids.layerOpacity->activeVoxelCount() << " voxels in "
-                  << std::chrono::duration<double>(std::chrono::steady_clock::now() - bakeStart).count()
+        bake::TreeGrids grids;
+        if (baked) {
+            grids = *baked;  // files bake wrote, checked against their manifests
+        } else {
+            std::cerr << "vdbtrace: baking the boughs at " << reference.voxelSize_cm << " cm\n";
+            grids = vdbtrace::bakeScene(loaded->traced, reference.voxelSize_cm);
+        }
+        std::cerr << "vdbtrace: " << grids.layerOpacity->activeVoxelCount() << " voxels of "
+                  << grids.voxelSize_cm << " cm in "
+                  << std::chrono::duration<double>(std::chrono::steady_clock::now() - readStart).count()
                   << " s\n";
         vdbtrace::ReferenceOptions options;
         options.subpixels = reference.subpixels;
@@ -264,6 +279,9 @@ int main(int argc, char** argv)
     renderCmd->add_option("--voxel-size", reference.voxelSize_cm,
                           "reference: voxel size of the baked boughs, cm")
         ->check(CLI::PositiveNumber);
+    renderCmd->add_option("--grids", reference.grids,
+                          "reference: baked .vdb files (bake tree/scene) instead of baking now")
+        ->check(CLI::ExistingFile);
     renderCmd->add_option("--subpixels", reference.subpixels,
                           "reference: rays per pixel along each axis (the cone's footprint)")
         ->check(CLI::Range(1, 16));

@@ -80,3 +80,12 @@ void writeTreeGrids(const TreeGrids& grids, const std::filesystem::path& path,
 TreeGrids readTreeGrids(const std::filesystem::path& path);
 
 }  // namespace pine::bake
+
+namespace pine::bake {
+
+/// The grids of several trees as one set (what a renderer marches through): all must share a
+/// voxel size (BakeError otherwise); where two overlap, the first keeps the voxel, as within a
+/// tree. The density pyramid is not merged; density keeps the largest scale of the inputs.
+TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees);
+
+}  // namespace pine::bake

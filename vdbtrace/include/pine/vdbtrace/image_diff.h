@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <vector>
+
 namespace pine::vdbtrace {
 
 /// Errors of `image` against `reference` (same size), on linear luminance of premultiplied RGB.
@@ -15,6 +17,13 @@ struct ImageErrors {
     double maxAbsolute = 0.0;
     double relativeFloor = 0.0;  ///< 1% of the reference's mean luminance
     std::size_t pixels = 0, relativePixels = 0;
+    /// The same restricted to the pixels where `image`'s "level" AOV rounds to 0 (no foliage),
+    /// 1 (needle), 2 (cone) or 3 (bough): which approximation costs what. Empty without it.
+    struct ByLevel {
+        double rmse = 0.0, meanRelative = 0.0;
+        std::size_t pixels = 0, relativePixels = 0;
+    };
+    std::vector<ByLevel> byLevel;
     nlohmann::json toJson() const;
 };
 
