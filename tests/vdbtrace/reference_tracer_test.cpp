@@ -2,6 +2,7 @@
 // continuous field, its convergence in the voxel size, and its edge cases.
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/cone_shader.h"
+#include "pine/analytic/true_cone_bough.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/image_diff.h"
@@ -9,16 +10,19 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/geometric.hpp>
+
 #include <cmath>
 
 namespace pine::vdbtrace {
 namespace {
 
-// One long bough along x seen side-on from -y; `lights` false leaves only coverage to measure.
+// One long bough through the origin seen from -y, its axis turned by `tilt_rad` from x towards
+// +y (0: side-on, orthogonal to the view).
 struct SideOn {
     scenes::Scene scene;
     TracedScene traced;
-    explicit SideOn(int height = 60)
+    explicit SideOn(int height = 60, double tilt_rad = 0.0)
     {
         scene = scenes::parseScene(R"({"name": "side-on bough",
   "camera": {"position": [0, -30, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 12,
@@ -28,10 +32,10 @@ struct SideOn {
                                    "side-on.json");
         traced = buildTracedScene(scene);
         TracedBough b;
-        b.base_cm = Vec3(-40, 0, 0);
-        b.tip_cm = Vec3(40, 0, 0);
-        b.axis = Vec3(1, 0, 0);
-        b.length_cm = 80;
+        b.axis = Vec3(std::cos(tilt_rad), std::sin(tilt_rad), 0);
+        b.base_cm = -20.0 * b.axis;
+        b.tip_cm = 20.0 * b.axis;
+        b.length_cm = 40;
         b.geometry.cone = {analytic::kPi / 8, 4.25, 0.05, 12};
         b.geometry.coneSpacing_cm = 0.9;
         b.radius_cm = analytic::boughRadius(b.geometry.cone);
@@ -41,10 +45,9 @@ struct SideOn {
     }
 };
 
-// Mean absolute error of the rows' opacity against the true-cone closed form: through the
-// field -ln(1 - A) |d . G|, G = (axis - cot(phi) radial) / dh, a ray orthogonal to the branch
-// at offset x has optical depth -ln(1 - A) cot(phi) / dh times the total variation of rho
-// along it, 2 (R - |x|).
+// Mean absolute error of the rows' opacity (the central column) against analytic's true-cone
+// bough: each row's ray at offset u = gap / R from the axis crosses trueConeLayers of them, so
+// its opacity is 1 - exp(-mu layers) (analytic/true_cone_bough.h).
 double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
 {
     const bake::TreeGrids grids = bakeScene(s.traced, voxel);
@@ -54,29 +57,31 @@ double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
     const TracedBough& b = s.traced.boughs.front();
     const ConeCamera camera(s.scene.camera);
     const double mu = -std::log1p(-b.layerOpacity), R = b.radius_cm;
-    const double cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad), dh = b.geometry.coneSpacing_cm;
     double sum = 0.0;
     int rows = 0;
     for (int y = 0; y < camera.height(); ++y) {
         const ConeRay ray = camera.cone(camera.width() / 2, y);
         Passage p;
         if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap > 0.9 * R) continue;
-        const double expected = 1.0 - std::exp(-mu * cotPhi / dh * 2.0 * (R - p.gap));
-        sum += std::abs(r.image.pixel(camera.width() / 2, y)[3] - expected);
+        const double cosV = glm::dot(-ray.direction, b.axis);
+        const double layers = analytic::trueConeLayers(b.geometry, cosV, std::sqrt(1 - cosV * cosV), p.gap / R);
+        sum += std::abs(r.image.pixel(camera.width() / 2, y)[3] - (1.0 - std::exp(-mu * layers)));
         ++rows;
     }
     if (rowsOut) *rowsOut = rows;
     return sum / rows;
 }
 
-TEST(ReferenceTracer, MatchesTheContinuousFieldInClosedForm)
+TEST(ReferenceTracer, MatchesAnalyticTrueConeOpacity)
 {
-    // Voxelized at 0.1 cm (R / 16) the field's boundary is off by up to half a voxel on each
-    // chord: an optical-depth error of order mu cot(phi) h / dh = 0.04, so 0.03 in opacity
-    // on average over the rows.
-    int rows = 0;
-    EXPECT_LT(rowError(SideOn(), 0.1, &rows), 0.03);
-    EXPECT_GT(rows, 10);
+    // A homogeneous bough, side-on and turned 35 degrees towards the view: voxelized at 0.1 cm
+    // (R / 16) the field's boundary is off by up to half a voxel on each chord, an optical-depth
+    // error of order mu cot(phi) h / dh = 0.04, so 0.03 in opacity on average over the rows.
+    for (const double tilt : {0.0, 35.0 * analytic::kPi / 180.0}) {
+        int rows = 0;
+        EXPECT_LT(rowError(SideOn(60, tilt), 0.1, &rows), 0.03) << "tilt " << tilt;
+        EXPECT_GT(rows, 10);
+    }
 }
 
 TEST(ReferenceTracer, ErrorShrinksWithTheVoxelSize)
