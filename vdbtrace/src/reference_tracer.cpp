@@ -153,25 +153,11 @@ public:
     }
 };
 
-double ReferenceTracer::branchTransmittance(const Vec3& x, const Light& l, double footprint,
+double ReferenceTracer::branchTransmittance(const Vec3& x, const Light& light, double footprint,
                                             std::size_t self) const
 {
-    ConeRay ray;
     double tMax;
-    if (l.directional) {
-        constexpr double far = 1e7;
-        ray.origin = x + far * l.towardsLight;
-        ray.direction = -l.towardsLight;
-        ray.spread = footprint / far;
-        tMax = far - 1e-3;
-    } else {
-        const Vec3 d = x - l.position_cm;
-        const double distance = glm::length(d);
-        ray.origin = l.position_cm;
-        ray.direction = d / distance;
-        ray.spread = footprint / distance;
-        tMax = distance - 1e-3;
-    }
+    const ConeRay ray = light.shadowCone(x, footprint, tMax);
     double transmittance = 1.0;
     mScene.bvh.query(ray, tMax, [&](std::uint32_t index) {
         if (index == self || !mScene.isBranch(index)) return;

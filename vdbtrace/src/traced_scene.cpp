@@ -63,6 +63,26 @@ void Light::at(const Vec3& p, Vec3& direction, double& distance, Vec3& irradianc
     irradiance = power / (distance * distance);
 }
 
+ConeRay Light::shadowCone(const Vec3& x, double footprint_cm, double& tMax) const
+{
+    ConeRay ray;
+    if (directional) {
+        constexpr double far = 1e7;  // cm
+        ray.origin = x + far * towardsLight;
+        ray.direction = -towardsLight;
+        ray.spread = footprint_cm / far;
+        tMax = far - 1e-3;
+    } else {
+        const Vec3 d = x - position_cm;
+        const double distance = glm::length(d);
+        ray.origin = position_cm;
+        ray.direction = d / distance;
+        ray.spread = footprint_cm / distance;
+        tMax = distance - 1e-3;
+    }
+    return ray;
+}
+
 TracedScene buildTracedScene(const scenes::Scene& scene)
 {
     TracedScene out;

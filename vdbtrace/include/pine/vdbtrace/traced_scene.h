@@ -22,6 +22,10 @@ struct Light {
     /// Unit direction from p towards the light, its distance (inf if directional) and the
     /// irradiance on a surface facing it.
     void at(const Vec3& p, Vec3& direction, double& distance, Vec3& irradiance) const;
+    /// The shadow cone to x (section 3.2: "we also use this cones for the shadow rays"): apex
+    /// at the light, as wide as `footprint_cm` at x, ending just before x (`tMax`). A
+    /// directional light's apex is far enough for the cone to be a cylinder.
+    ConeRay shadowCone(const Vec3& x, double footprint_cm, double& tMax) const;
 };
 
 struct TracedBranch {
