@@ -9,6 +9,8 @@ find_package(nlohmann_json CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(OpenEXR CONFIG REQUIRED)
 find_package(OpenImageIO CONFIG REQUIRED)
+# Embree 3 (libembree-dev) exports the imported target `embree`: the BVH of the geometry method.
+find_package(embree 3 CONFIG REQUIRED)
 
 # OpenImageIO's exported target names /usr/include/opencv4, which Debian does not install
 # with it: drop that directory from the target.

@@ -10,6 +10,7 @@ packages=(
   libopenimageio-dev openimageio-tools libopenexr-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev
+  libembree-dev
   python3-matplotlib python3-numpy
 )
 

@@ -24,7 +24,7 @@ expect_error "missing scene" 2 "missing.json" -- render "$work/missing.json" --o
 printf '{"camera": {' >"$work/broken.json"
 expect_error "malformed scene" 2 "broken.json:1:" -- render "$work/broken.json" --out "$work/a.exr"
 expect_error "unwritable output" 2 "no/such/dir" -- render "$src/scenes/bough.json" --out "$work/no/such/dir/a.exr"
-expect_error "unknown method" 2 "not available" -- render "$src/scenes/bough.json" --method geometry --out "$work/a.exr"
+expect_error "unknown method" 2 "not available" -- render "$src/scenes/bough.json" --method nonsense --out "$work/a.exr"
 expect_error "bad option" 2 "force-level" -- render "$src/scenes/bough.json" --out "$work/a.exr" --force-level 7
 [ -z "$(ls "$work" | grep -v -e '^out$' -e '^err$' -e '^broken.json$')" ] || fail "failed runs left files: $(ls "$work")"
 

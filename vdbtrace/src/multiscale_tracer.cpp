@@ -3,6 +3,7 @@
 #include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/ground_hit.h"
+#include "pine/vdbtrace/needle_layout.h"
 
 #include <glm/geometric.hpp>
 #include <tbb/parallel_for.h>
@@ -29,16 +30,6 @@ struct Layer {
 };
 
 double luminance(const Vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
-
-// A deterministic angle in [0, 2 pi) for cone j of a bough: where its first needle points.
-double coneRoll(unsigned seed, long j)
-{
-    std::uint64_t z = (std::uint64_t(seed) << 32) ^ std::uint64_t(j) ^ 0x9e3779b97f4a7c15ull;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return 2.0 * kPi * double(z >> 11) * 0x1.0p-53;
-}
 
 class PixelTracer {
 public:
@@ -84,23 +75,8 @@ private:
 double PixelTracer::shadow(const Vec3& x, std::size_t light, double footprint, std::size_t self)
 {
     ++mStats.shadowRays;
-    const Light& l = mScene.lights[light];
-    ConeRay ray;
     double tMax;
-    if (l.directional) {
-        constexpr double far = 1e7;  // cm: a cone from that far is a cylinder here
-        ray.origin = x + far * l.towardsLight;
-        ray.direction = -l.towardsLight;
-        ray.spread = footprint / far;
-        tMax = far * (1.0 - 1e-9) - 1e-3;
-    } else {
-        const Vec3 d = x - l.position_cm;
-        const double distance = glm::length(d);
-        ray.origin = l.position_cm;
-        ray.direction = d / distance;
-        ray.spread = footprint / distance;
-        tMax = distance - 1e-3;
-    }
+    const ConeRay ray = mScene.lights[light].shadowCone(x, footprint, tMax);
     double transmittance = 1.0;
     mScene.bvh.query(ray, tMax, [&](std::uint32_t index) {
         if (index == self || transmittance < 1e-4) return;
@@ -229,10 +205,12 @@ void PixelTracer::addCrossings(const ConeRay& ray, std::size_t index, const Trac
     const Vec3 mid = ray.origin + 0.5 * (tIn + tOut) * ray.direction;
     std::vector<Vec3> irradiance, towards;
     lightAt(mid, ray.width(0.5 * (tIn + tOut)), index, irradiance, towards);
-    const Vec3 e1 = analytic::anyPerpendicular(b.axis), e2 = glm::cross(b.axis, e1);
-    const long jMax = long(std::floor(b.length_cm / dh));
-    const int needles = std::max(1, int(std::lround(b.geometry.cone.needlesPerCone)));
-    const double r = b.geometry.cone.needleRadius_cm, l = b.geometry.cone.needleLength_cm;
+    // The same needles as the explicit-needle ground truth (needle_layout.h).
+    const NeedleLayout layout(b);
+    const Vec3 e1 = layout.e1(), e2 = layout.e2();
+    const long jMax = layout.lastCone();
+    const int needles = layout.needlesPerCone();
+    const double r = layout.radius(), l = layout.length();
 
     const double dt = dh / (4.0 * (1.0 + cotPhi));
     double t0 = tIn, g0 = g(t0);
@@ -256,12 +234,15 @@ void PixelTracer::addCrossings(const ConeRay& ray, std::size_t index, const Trac
             }
             // Level 1: the cone's needles nearest the crossing's azimuth, as cylinders.
             const double theta = std::atan2(glm::dot(radial, e2), glm::dot(radial, e1));
-            const double roll = coneRoll(b.seed, j);
+            const double roll = layout.roll(j);
             const long nearest = std::lround((theta - roll) * needles / (2 * kPi));
-            const Vec3 apex = b.base_cm + (double(j) * dh) * b.axis;
-            for (long i = nearest - 1; i <= nearest + 1; ++i) {
-                const double a = roll + 2 * kPi * double(i) / needles;
-                const Vec3 needle = cosPhi * b.axis + sinPhi * (std::cos(a) * e1 + std::sin(a) * e2);
+            const Vec3 apex = layout.apex(j);
+            // The nearest needle and its two neighbours, each once: with fewer than three
+            // needles per cone the neighbours wrap onto the same needles.
+            const long from = needles >= 3 ? nearest - 1 : 0;
+            const long to = needles >= 3 ? nearest + 1 : needles - 1;
+            for (long i = from; i <= to; ++i) {
+                const Vec3 needle = layout.direction(layout.azimuth(j, i));
                 Passage p;
                 if (!closestPassage(ray, apex, apex + l * needle, p)) continue;
                 const double c = stripCoverage(p.gap, r, ray.width(p.t));

@@ -1,0 +1,566 @@
+// The explicit-needle ground truth: solid cylinders in an Embree 3 BVH, point samples, shadow
+// rays, and the per-point integrands of the paper's eqs. (1) and (2).
+//
+// Cylinders are Embree *user* geometry, not RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE: a round
+// linear curve is a capsule (a hemisphere of radius r at each end adds pi r^2 to the needle's
+// projected area 2 r l, +1.8% for the paper's needle) in single precision, whereas section 4
+// integrates over a cylinder and the multiscale level 1 covers exactly its strip. Here Embree
+// only builds and walks the BVH; each candidate is intersected exactly, in double precision,
+// with the ray the sample really is (carried in the intersection context), as a flat-capped
+// solid cylinder.
+#include "pine/vdbtrace/geometry_tracer.h"
+
+#include "pine/vdbtrace/cone_camera.h"
+#include "pine/vdbtrace/ground_hit.h"
+#include "pine/vdbtrace/needle_layout.h"
+
+#include <embree3/rtcore.h>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pine::vdbtrace {
+namespace {
+
+constexpr double kPi = analytic::kPi;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double luminance(const Vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+// One solid cylinder: a needle or a branch. The axis is stored in float (tip error l * 6e-8),
+// the base in double so that a forest kilometres wide keeps its needles' 0.05 cm radius exact.
+struct Cylinder {
+    Vec3 base;
+    glm::vec3 axis;  // unit
+    float length = 0.0f, radius = 0.0f;
+    std::uint32_t owner = 0;  // index of the bough (needles) or the branch
+};
+
+struct CylinderSet {
+    std::vector<Cylinder> cylinders;
+    double pad = 0.0;  // cm added to every box: the float ray Embree walks vs our double ray
+    unsigned geomID = RTC_INVALID_GEOMETRY_ID;
+};
+
+// The ray as the sample really is, in double, after Embree's own context (which Embree hands
+// back to the callbacks): the closest hit is found here, not in Embree's float fields.
+struct RayContext {
+    RTCIntersectContext embree;
+    Vec3 origin{0.0}, direction{0.0};
+    double tMin = 0.0, tMax = kInf;
+    double t = kInf;  // closest hit so far
+    unsigned geomID = RTC_INVALID_GEOMETRY_ID, primID = 0;
+    bool cap = false;
+    unsigned skipGeom = RTC_INVALID_GEOMETRY_ID, skipPrim = 0;  // shadow rays: the surface itself
+};
+
+// The ray's interval inside the solid cylinder: the infinite cylinder's chord intersected with
+// the slab 0 <= (p - base).axis <= l. The chord comes from the closest approach (no
+// cancellation between two large squares when the ray passes far away). `cap`: entered
+// through an end.
+bool intersectCylinder(const Vec3& o, const Vec3& d, const Cylinder& c, double& tIn,
+                       double& tOut, bool& cap)
+{
+    const Vec3 u(c.axis);
+    const double r = c.radius, l = c.length;
+    const Vec3 w = o - c.base;
+    const double wu = glm::dot(w, u), du = glm::dot(d, u);
+    double s0 = -kInf, s1 = kInf;
+    if (du != 0.0) {
+        s0 = -wu / du;
+        s1 = (l - wu) / du;
+        if (s0 > s1) std::swap(s0, s1);
+    } else if (wu < 0.0 || wu > l) {
+        return false;
+    }
+    const Vec3 ww = w - wu * u, dd = d - du * u;
+    const double a = glm::dot(dd, dd);
+    double c0 = -kInf, c1 = kInf;
+    if (a > 0.0) {
+        const double tc = -glm::dot(ww, dd) / a;
+        const Vec3 p = ww + tc * dd;
+        const double h2 = glm::dot(p, p);
+        if (h2 > r * r) return false;
+        const double half = std::sqrt((r * r - h2) / a);
+        c0 = tc - half;
+        c1 = tc + half;
+    } else if (glm::dot(ww, ww) > r * r) {
+        return false;
+    }
+    tIn = std::max(c0, s0);
+    tOut = std::min(c1, s1);
+    cap = s0 > c0;
+    return tIn < tOut;
+}
+
+Vec3 cylinderNormal(const Cylinder& c, const Vec3& x, const Vec3& d, bool cap)
+{
+    const Vec3 u(c.axis);
+    if (cap) return glm::dot(d, u) > 0.0 ? -u : u;
+    const Vec3 w = x - c.base;
+    const Vec3 radial = w - glm::dot(w, u) * u;
+    const double len = glm::length(radial);
+    return len > 0.0 ? radial / len : analytic::anyPerpendicular(u);
+}
+
+void cylinderBoundsFn(const RTCBoundsFunctionArguments* args)
+{
+    const auto* set = static_cast<const CylinderSet*>(args->geometryUserPtr);
+    const Cylinder& c = set->cylinders[args->primID];
+    const Vec3 u(c.axis), tip = c.base + double(c.length) * u;
+    float lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+        // A disc of radius r across u reaches r sqrt(1 - u_k^2) along axis k.
+        const double e = c.radius * std::sqrt(std::max(0.0, 1.0 - u[k] * u[k])) + set->pad;
+        lo[k] = std::nextafter(float(std::min(c.base[k], tip[k]) - e), -INFINITY);
+        hi[k] = std::nextafter(float(std::max(c.base[k], tip[k]) + e), INFINITY);
+    }
+    RTCBounds* b = args->bounds_o;
+    b->lower_x = lo[0], b->lower_y = lo[1], b->lower_z = lo[2];
+    b->upper_x = hi[0], b->upper_y = hi[1], b->upper_z = hi[2];
+}
+
+void cylinderIntersectFn(const RTCIntersectFunctionNArguments* args)
+{
+    if (args->N != 1 || !args->valid[0]) return;
+    auto* ctx = reinterpret_cast<RayContext*>(args->context);
+    const auto* set = static_cast<const CylinderSet*>(args->geometryUserPtr);
+    double tIn, tOut;
+    bool cap;
+    if (!intersectCylinder(ctx->origin, ctx->direction, set->cylinders[args->primID], tIn, tOut,
+                           cap)) {
+        return;
+    }
+    if (!(tIn > ctx->tMin) || tIn > ctx->tMax || tIn > ctx->t) return;
+    // Equal distances: the lower (geometry, primitive) wins, whatever order Embree visits in.
+    if (tIn == ctx->t && (args->geomID > ctx->geomID ||
+                          (args->geomID == ctx->geomID && args->primID > ctx->primID))) {
+        return;
+    }
+    ctx->t = tIn;
+    ctx->geomID = args->geomID;
+    ctx->primID = args->primID;
+    ctx->cap = cap;
+    // Embree culls boxes beyond tfar: round up so that an equal-distance candidate survives.
+    auto* rayhit = reinterpret_cast<RTCRayHit*>(args->rayhit);
+    rayhit->ray.tfar = std::nextafter(float(tIn), INFINITY);
+    rayhit->hit.geomID = args->geomID;
+    rayhit->hit.primID = args->primID;
+}
+
+void cylinderOccludedFn(const RTCOccludedFunctionNArguments* args)
+{
+    if (args->N != 1 || !args->valid[0]) return;
+    auto* ctx = reinterpret_cast<RayContext*>(args->context);
+    if (args->geomID == ctx->skipGeom && args->primID == ctx->skipPrim) return;
+    const auto* set = static_cast<const CylinderSet*>(args->geometryUserPtr);
+    double tIn, tOut;
+    bool cap;
+    if (!intersectCylinder(ctx->origin, ctx->direction, set->cylinders[args->primID], tIn, tOut,
+                           cap)) {
+        return;
+    }
+    if (tOut > ctx->tMin && tIn < ctx->tMax) {
+        reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
+    }
+}
+
+// Embree's device and scene, released whatever happens; Embree's allocations counted.
+class EmbreeScene {
+public:
+    EmbreeScene()
+    {
+        mDevice = rtcNewDevice(nullptr);
+        if (!mDevice) throw std::runtime_error("Embree: cannot create a device");
+        rtcSetDeviceErrorFunction(
+            mDevice,
+            [](void* self, RTCError, const char* message) {
+                auto* s = static_cast<EmbreeScene*>(self);
+                if (s->mError.empty()) s->mError = message ? message : "unknown error";
+            },
+            this);
+        rtcSetDeviceMemoryMonitorFunction(
+            mDevice,
+            [](void* self, ssize_t bytes, bool) {
+                auto* s = static_cast<EmbreeScene*>(self);
+                const std::int64_t now = s->mBytes.fetch_add(bytes) + bytes;
+                std::int64_t peak = s->mPeak.load();
+                while (now > peak && !s->mPeak.compare_exchange_weak(peak, now)) {
+                }
+                return true;
+            },
+            this);
+        mScene = rtcNewScene(mDevice);
+        // Robust traversal: no box is skipped for rounding when a ray grazes it. Compact:
+        // 11% less BVH memory on the paper's forest (2.45 M needles), no slower.
+        rtcSetSceneFlags(mScene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT);
+    }
+    ~EmbreeScene()
+    {
+        if (mScene) rtcReleaseScene(mScene);
+        if (mDevice) rtcReleaseDevice(mDevice);
+    }
+    EmbreeScene(const EmbreeScene&) = delete;
+    EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+    void attach(CylinderSet& set)
+    {
+        if (set.cylinders.empty()) return;
+        RTCGeometry g = rtcNewGeometry(mDevice, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(g, unsigned(set.cylinders.size()));
+        rtcSetGeometryUserData(g, &set);
+        rtcSetGeometryBoundsFunction(g, cylinderBoundsFn, nullptr);
+        rtcSetGeometryIntersectFunction(g, cylinderIntersectFn);
+        rtcSetGeometryOccludedFunction(g, cylinderOccludedFn);
+        rtcCommitGeometry(g);
+        set.geomID = rtcAttachGeometry(mScene, g);
+        rtcReleaseGeometry(g);
+        check();
+    }
+    void commit()
+    {
+        rtcCommitScene(mScene);
+        check();
+    }
+    RTCScene scene() const { return mScene; }
+    std::size_t peakBytes() const { return std::size_t(std::max<std::int64_t>(0, mPeak.load())); }
+
+private:
+    void check() const
+    {
+        if (!mError.empty()) throw std::runtime_error("Embree: " + mError);
+    }
+
+    RTCDevice mDevice = nullptr;
+    RTCScene mScene = nullptr;
+    std::string mError;
+    std::atomic<std::int64_t> mBytes{0}, mPeak{0};
+};
+
+// The sample pattern: Sobol' dimensions 1 and 2, a (0,2)-sequence (Kollig & Keller 2002),
+// each digitally shifted by a hash of the pixel so that neighbouring pixels do not share an
+// error pattern. A digital shift keeps every elementary interval stratified and makes each
+// point uniform in the pixel: the estimator is unbiased.
+std::uint32_t sobol1(std::uint32_t i)
+{
+    std::uint32_t r = 0;
+    for (std::uint32_t v = 1u << 31; i; i >>= 1, v >>= 1) {
+        if (i & 1u) r ^= v;
+    }
+    return r;
+}
+
+std::uint32_t sobol2(std::uint32_t i)
+{
+    std::uint32_t r = 0;
+    for (std::uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1) {
+        if (i & 1u) r ^= v;
+    }
+    return r;
+}
+
+std::uint64_t mix(std::uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+class SampleTracer {
+public:
+    SampleTracer(const TracedScene& scene, const EffectsPlan& plan, const EmbreeScene& embree,
+                 const CylinderSet& branches, const CylinderSet& needles, RenderStats& stats)
+        : mScene(scene), mPlan(plan), mEmbree(embree), mBranches(branches), mNeedles(needles),
+          mStats(stats), mShadows(plan.shadowRays || plan.selfShadowing)
+    {
+    }
+
+    /// One point sample: adds its radiance to the sums, returns the hit's distance (inf: none)
+    /// and whether it was a needle.
+    double trace(const ConeRay& ray, Vec3& diffuse, Vec3& specular, bool& needle);
+
+private:
+    bool occluded(const Vec3& x, const Vec3& towards, double distance, unsigned geomID,
+                  unsigned primID);
+
+    const TracedScene& mScene;
+    const EffectsPlan& mPlan;
+    const EmbreeScene& mEmbree;
+    const CylinderSet& mBranches;
+    const CylinderSet& mNeedles;
+    RenderStats& mStats;
+    bool mShadows;
+};
+
+bool SampleTracer::occluded(const Vec3& x, const Vec3& towards, double distance,
+                            unsigned geomID, unsigned primID)
+{
+    ++mStats.shadowRays;
+    RayContext ctx;
+    rtcInitIntersectContext(&ctx.embree);
+    ctx.origin = x;
+    ctx.direction = towards;
+    ctx.tMin = 0.0;
+    ctx.tMax = distance;
+    // A convex cylinder never shadows its own lit side: skip it instead of offsetting x.
+    ctx.skipGeom = geomID;
+    ctx.skipPrim = primID;
+    RTCRay ray{};
+    ray.org_x = float(x.x), ray.org_y = float(x.y), ray.org_z = float(x.z);
+    ray.dir_x = float(towards.x), ray.dir_y = float(towards.y), ray.dir_z = float(towards.z);
+    ray.tnear = 0.0f;
+    ray.tfar = std::isfinite(distance) ? std::nextafter(float(distance), INFINITY) : INFINITY;
+    ray.mask = ~0u;
+    rtcOccluded1(mEmbree.scene(), &ctx.embree, &ray);
+    return ray.tfar < 0.0f;
+}
+
+double SampleTracer::trace(const ConeRay& ray, Vec3& diffuse, Vec3& specular, bool& needle)
+{
+    ++mStats.coneRays;
+    needle = false;
+    double tGround = kInf;
+    Vec3 groundNormal(0.0);
+    if (!hitGround(mScene.scene->ground, ray, tGround, groundNormal)) tGround = kInf;
+
+    RayContext ctx;
+    rtcInitIntersectContext(&ctx.embree);
+    ctx.origin = ray.origin;
+    ctx.direction = ray.direction;
+    ctx.tMax = tGround;
+    RTCRayHit rh{};
+    rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y);
+    rh.ray.org_z = float(ray.origin.z);
+    rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y);
+    rh.ray.dir_z = float(ray.direction.z);
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::isfinite(tGround) ? std::nextafter(float(tGround), INFINITY) : INFINITY;
+    rh.ray.mask = ~0u;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(mEmbree.scene(), &ctx.embree, &rh);
+
+    const bool cylinder = ctx.geomID != RTC_INVALID_GEOMETRY_ID;
+    if (!cylinder && !std::isfinite(tGround)) return kInf;
+    const double t = cylinder ? ctx.t : tGround;
+    const Vec3 x = ray.origin + t * ray.direction, V = -ray.direction;
+
+    // What the hit is and how it reflects.
+    Vec3 N = groundNormal, albedo = mScene.scene->ground.albedo;
+    double weight = 0.0, exponent = 1.0;
+    const bool isNeedle = cylinder && ctx.geomID == mNeedles.geomID;
+    if (cylinder) {
+        const CylinderSet& set = isNeedle ? mNeedles : mBranches;
+        const Cylinder& c = set.cylinders[ctx.primID];
+        N = cylinderNormal(c, x, ray.direction, ctx.cap);
+        if (isNeedle) {
+            const TracedBough& b = mScene.boughs[c.owner];
+            albedo = b.needleAlbedo;
+            weight = b.specularWeight;
+            exponent = b.exponent;
+            ++mStats.needleHits;
+        } else {
+            albedo = mScene.branches[c.owner].albedo;
+            ++mStats.branchHits;
+        }
+    } else {
+        ++mStats.groundHits;
+    }
+    needle = isNeedle;
+    const bool shadeSpecular = mPlan.specular && isNeedle;
+
+    for (const Light& light : mScene.lights) {
+        Vec3 L, E;
+        double distance;
+        light.at(x, L, distance, E);
+        // The integrands of section 4: eq. (1)'s (N.L) 1(N.L > 0) and eq. (2)'s
+        // (N.H)^n 1(N.H > 0), per unit of visible surface; the (N.V) weight of both is the
+        // sampling itself (a pixel sample lands on the surface with density N.V).
+        const double cosL = std::max(0.0, glm::dot(N, L));
+        double lobe = 0.0;
+        if (shadeSpecular) {
+            const Vec3 h = L + V;
+            const double len = glm::length(h);
+            const double cosH = len > 0.0 ? std::max(0.0, glm::dot(N, h / len)) : 0.0;
+            lobe = cosH > 0.0 ? std::pow(cosH, exponent) : 0.0;
+        }
+        const bool lit = (mPlan.diffuse && cosL > 0.0) || lobe > 0.0;
+        if (lit && mShadows &&
+            occluded(x, L, distance, cylinder ? ctx.geomID : RTC_INVALID_GEOMETRY_ID,
+                     ctx.primID)) {
+            E = Vec3(0.0);
+        }
+        if (mPlan.diffuse) {
+            diffuse += albedo / kPi * E * cosL;
+            ++mStats.diffuseEvaluations;
+        }
+        if (shadeSpecular) {
+            specular += weight * E * lobe;
+            ++mStats.specularEvaluations;
+        }
+    }
+    return t;
+}
+
+// Every needle of every bough (needle_layout.h) and every branch, as cylinders; the box pad
+// covers the float rounding of rays within the scene's extent.
+void layOut(const TracedScene& scene, CylinderSet& branches, CylinderSet& needles)
+{
+    Aabb box;
+    box.grow(scene.scene->camera.position_cm);
+    for (const Light& l : scene.lights) {
+        if (!l.directional) box.grow(l.position_cm);
+    }
+    branches.cylinders.reserve(scene.branches.size());
+    for (std::size_t i = 0; i < scene.branches.size(); ++i) {
+        const TracedBranch& br = scene.branches[i];
+        const Vec3 d = br.tip_cm - br.base_cm;
+        const double length = glm::length(d);
+        if (!(length > 0.0)) continue;
+        branches.cylinders.push_back({br.base_cm, glm::vec3(d / length), float(length),
+                                      float(br.radius_cm), std::uint32_t(i)});
+        box.grow(cylinderBounds(br.base_cm, br.tip_cm, br.radius_cm));
+    }
+    std::size_t count = 0;
+    for (const TracedBough& b : scene.boughs) {
+        const NeedleLayout layout(b);
+        count += std::size_t(layout.lastCone() + 1) * layout.needlesPerCone();
+    }
+    needles.cylinders.reserve(count);
+    for (std::size_t k = 0; k < scene.boughs.size(); ++k) {
+        const TracedBough& b = scene.boughs[k];
+        const NeedleLayout layout(b);
+        if (!(layout.length() > 0.0 && layout.radius() > 0.0)) continue;
+        layout.forEach([&](const Vec3& apex, const Vec3& dir) {
+            needles.cylinders.push_back({apex, glm::vec3(dir), float(layout.length()),
+                                         float(layout.radius()), std::uint32_t(k)});
+        });
+        box.grow(cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm));
+    }
+    // A float ray differs from the double one by ~6e-8 of its coordinates and of the distance
+    // travelled, both bounded by the scene's extent: pad by 1e-6 of it, eight times that.
+    const double pad = box.valid() ? 1e-6 * glm::length(box.hi - box.lo) + 1e-6 : 1e-6;
+    branches.pad = needles.pad = pad;
+}
+
+}  // namespace
+
+RenderResult renderGeometry(const TracedScene& scene, const GeometryOptions& options)
+{
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    const ConeCamera camera(scene.scene->camera);
+    const EffectsPlan plan = EffectsPlan::from(scene.scene->effects);
+    const int samples = std::max(1, options.samples);
+
+    CylinderSet branches, needles;
+    layOut(scene, branches, needles);
+    EmbreeScene embree;
+    embree.attach(branches);
+    embree.attach(needles);
+    embree.commit();
+    GeometryBuild build;
+    build.needles = needles.cylinders.size();
+    build.branches = branches.cylinders.size();
+    build.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    build.primitiveBytes = (needles.cylinders.capacity() + branches.cylinders.capacity()) *
+                           sizeof(Cylinder);
+    build.embreePeakBytes = embree.peakBytes();
+    if (options.built) options.built(build);
+
+    RenderResult result;
+    result.image = Image(camera.width(), camera.height());
+    Image& image = result.image;
+    for (const char* name : {"level", "depth", "diffuse", "specular", "foliage"}) image.aov(name);
+
+    const int tile = std::max(1, options.tileSize);
+    const int tilesX = (camera.width() + tile - 1) / tile;
+    const int tilesY = (camera.height() + tile - 1) / tile;
+    const int tiles = tilesX * tilesY;
+    // A sample is a point: its cone is as narrow as a sample's share of the pixel (only the
+    // ground test reads the ray, and only its axis).
+    const double sampleWidth = 1.0 / std::sqrt(double(samples));
+    std::mutex statsMutex;
+    std::atomic<int> done{0}, reported{0};
+    tbb::parallel_for(0, tiles, [&](int k) {
+        RenderStats stats;
+        SampleTracer tracer(scene, plan, embree, branches, needles, stats);
+        std::vector<double> depths;
+        const int x0 = (k % tilesX) * tile, y0 = (k / tilesX) * tile;
+        for (int y = y0; y < std::min(y0 + tile, camera.height()); ++y) {
+            for (int x = x0; x < std::min(x0 + tile, camera.width()); ++x) {
+                const auto t0 = Clock::now();
+                const std::uint64_t key = mix((std::uint64_t(options.sampleSeed) << 48) ^
+                                              (std::uint64_t(std::uint32_t(y)) << 24) ^
+                                              std::uint64_t(std::uint32_t(x)));
+                const std::uint32_t shiftX = std::uint32_t(key), shiftY = std::uint32_t(key >> 32);
+                Vec3 diffuse(0.0), specular(0.0);
+                int hits = 0, needleHits = 0;
+                depths.clear();
+                for (int s = 0; s < samples; ++s) {
+                    const double u = double(sobol1(std::uint32_t(s)) ^ shiftX) * 0x1.0p-32;
+                    const double v = double(sobol2(std::uint32_t(s)) ^ shiftY) * 0x1.0p-32;
+                    bool needle;
+                    const double t =
+                        tracer.trace(camera.coneAt(x + u, y + v, sampleWidth), diffuse, specular,
+                                     needle);
+                    if (std::isfinite(t)) {
+                        ++hits;
+                        depths.push_back(t);
+                    }
+                    needleHits += needle;
+                }
+                const double inv = 1.0 / samples;
+                diffuse *= inv;
+                specular *= inv;
+                const Vec3 colour = diffuse + specular;
+                float* p = image.pixel(x, y);
+                p[0] = float(colour.x);
+                p[1] = float(colour.y);
+                p[2] = float(colour.z);
+                p[3] = float(hits * inv);
+                const std::size_t i = std::size_t(y) * camera.width() + x;
+                // Depth where the covered fraction passes 0.5, as the multiscale tracer's
+                // accumulated alpha does: the ceil(S/2)-th nearest hit.
+                const std::size_t half = std::size_t((samples + 1) / 2);
+                if (depths.size() >= half) {
+                    std::nth_element(depths.begin(), depths.begin() + (half - 1), depths.end());
+                    image.aovs["depth"][i] = float(depths[half - 1]);
+                }
+                image.aovs["diffuse"][i] = float(luminance(diffuse));
+                image.aovs["specular"][i] = float(luminance(specular));
+                image.aovs["foliage"][i] = float(needleHits * inv);
+                ++stats.pixelsPerLevel[0];
+                stats.nanosecondsPerLevel[0] += std::uint64_t(
+                    std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0)
+                        .count());
+            }
+        }
+        {
+            std::lock_guard<std::mutex> lock(statsMutex);
+            result.stats += stats;
+        }
+        const int finished = ++done;
+        if (options.progress) {
+            const int percent = finished * 50 / tiles;  // steps of 2%
+            int last = reported.load();
+            while (percent > last && !reported.compare_exchange_weak(last, percent)) {
+            }
+            if (percent > last) options.progress(double(finished) / tiles);
+        }
+    });
+    result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return result;
+}
+
+}  // namespace pine::vdbtrace
