@@ -1,9 +1,12 @@
-// vdbtrace: render a scene with the multiscale cone tracer, or benchmark it.
+// vdbtrace: render a scene with the multiscale cone tracer, benchmark it, or compare methods.
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
+#include "pine/vdbtrace/compare.h"
+#include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
+#include "pine/vdbtrace/preview.h"
 #include "pine/vdbtrace/reference_tracer.h"
 #include "pine/vdbtrace/stats_json.h"
 #include "pine/vdbtrace/traced_scene.h"
@@ -83,11 +86,11 @@ struct ReferenceSettings {
 
 int render(const fs::path& sceneFile, const std::string& method, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs, int forceLevel,
-           const ReferenceSettings& reference)
+           const ReferenceSettings& reference, int samples)
 {
-    if (method != "multiscale" && method != "reference") {
+    if (method != "multiscale" && method != "reference" && method != "geometry") {
         std::cerr << "vdbtrace render: method '" << method
-                  << "' is not available yet (multiscale, reference)\n";
+                  << "' is not available (multiscale, reference, geometry)\n";
         return 2;
     }
     vdbtrace::checkWritable(out);
@@ -108,6 +111,17 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
         vdbtrace::RenderOptions options = withProgress("rendering");
         options.forceLevel = forceLevel;
         result = vdbtrace::renderMultiscale(loaded->traced, options);
+    } else if (method == "geometry") {
+        vdbtrace::GeometryOptions options;
+        options.samples = samples;
+        options.progress = withProgress("rendering").progress;
+        options.built = [](const vdbtrace::GeometryBuild& b) {
+            std::cerr << "vdbtrace: " << b.needles << " needles and " << b.branches
+                      << " branches as cylinders, BVH built in " << b.seconds << " s ("
+                      << double(b.primitiveBytes) / (1 << 20) << " MiB of cylinders, Embree peak "
+                      << double(b.embreePeakBytes) / (1 << 20) << " MiB)\n";
+        };
+        result = vdbtrace::renderGeometry(loaded->traced, options);
     } else {
         bake::TreeGrids grids;
         if (baked) {
@@ -143,18 +157,11 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
                                ? "voxel " + std::to_string(reference.voxelSize_cm) + " cm, " +
                                      std::to_string(reference.subpixels * reference.subpixels) +
                                      " rays per pixel, exact per voxel span"
-                               : "n/a"}};
+                               : "n/a"},
+        {"pine:samples", method == "geometry" ? std::to_string(samples) : "n/a"}};
     vdbtrace::writeExr(result.image, out, metadata);
     // The preview shows the scene's background behind what the cone did not cover.
-    vdbtrace::Image preview = result.image;
-    for (int y = 0; y < preview.height; ++y) {
-        for (int x = 0; x < preview.width; ++x) {
-            float* p = preview.pixel(x, y);
-            for (int c = 0; c < 3; ++c) p[c] += (1.0f - p[3]) * float(s.render.background[c]);
-            p[3] = 1.0f;
-        }
-    }
-    vdbtrace::writePng(preview, besideWith(out, ".png"));
+    vdbtrace::writePreviewPng(result.image, s.render.background, besideWith(out, ".png"));
     for (const std::string& aov : aovs) {
         if (aov == "level") vdbtrace::writeLevelPng(result.image, besideWith(out, ".level.png"));
     }
@@ -170,6 +177,7 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
             j["voxel_size_cm"] = reference.voxelSize_cm;
             j["rays_per_pixel"] = reference.subpixels * reference.subpixels;
         }
+        if (method == "geometry") j["samples_per_pixel"] = samples;
         vdbtrace::writeJsonAtomically(j, statsFile);
     }
     const auto& st = result.stats;
@@ -274,7 +282,7 @@ int main(int argc, char** argv)
     renderCmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
     renderCmd->add_option("--method", method,
                           "multiscale (closed forms), reference (equation 7 through OpenVDB "
-                          "grids); geometry: later");
+                          "grids), geometry (explicit needle cylinders, the ground truth)");
     ReferenceSettings reference;
     renderCmd->add_option("--voxel-size", reference.voxelSize_cm,
                           "reference: voxel size of the baked boughs, cm")
@@ -285,6 +293,9 @@ int main(int argc, char** argv)
     renderCmd->add_option("--subpixels", reference.subpixels,
                           "reference: rays per pixel along each axis (the cone's footprint)")
         ->check(CLI::Range(1, 16));
+    int samples = 16;
+    renderCmd->add_option("--samples", samples, "geometry: point samples per pixel")
+        ->check(CLI::Range(1, 65536));
     renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")->required();
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
@@ -307,6 +318,26 @@ int main(int argc, char** argv)
     diffCmd->add_option("--scale", diffScale, "Error shown white in error.png (default: the max)")
         ->check(CLI::NonNegativeNumber);
 
+    vdbtrace::CompareOptions compare;
+    bool quick = false, noPlot = false;
+    std::string resolution;
+    auto* compareCmd = app.add_subcommand(
+        "compare", "Every method and setting against the geometry ground truth: time, error, "
+                   "flicker (report.md, report.csv, images, error_vs_time.png)");
+    compareCmd->add_option("scene", compare.sceneFile, "Scene file (JSON)")->required();
+    compareCmd->add_option("--out-dir", compare.outDir, "Folder for the report and images")
+        ->required();
+    compareCmd->add_flag("--quick", quick,
+                         "Fewer settings (truth 16 spp, geometry 1 and 4 spp, voxels 1 and "
+                         "0.5 cm) and an 8-frame dolly at half resolution");
+    compareCmd->add_option("--resolution", resolution, "WxH instead of the camera's (same view)")
+        ->check([](const std::string& text) {
+            int w = 0, h = 0;
+            return vdbtrace::parseResolution(text, w, h) ? std::string()
+                                                          : "expected WxH, e.g. 64x48";
+        });
+    compareCmd->add_flag("--no-plot", noPlot, "Skip error_vs_time.png (matplotlib)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -321,9 +352,17 @@ int main(int argc, char** argv)
     }
     try {
         if (*renderCmd) {
-            return render(sceneFile, method, out, statsFile, aovs, forceLevel, reference);
+            return render(sceneFile, method, out, statsFile, aovs, forceLevel, reference, samples);
         }
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
+        if (*compareCmd) {
+            compare.settings = vdbtrace::CompareSettings::forQuick(quick);
+            compare.plot = !noPlot;
+            if (!resolution.empty()) {
+                vdbtrace::parseResolution(resolution, compare.width, compare.height);
+            }
+            return vdbtrace::runCompare(compare);
+        }
         return bench(sceneFile, scaling);
     } catch (const scenes::SceneError& e) {
         std::cerr << "vdbtrace: " << e.what() << '\n';

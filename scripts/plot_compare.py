@@ -1,0 +1,87 @@
+#!/usr/bin/python3
+"""Plot what accuracy costs in time, from `vdbtrace compare`'s report.csv.
+
+Usage: MPLBACKEND=Agg /usr/bin/python3 scripts/plot_compare.py DIR
+
+Reads DIR/report.csv (columns method, setting, seconds, rmse, ...) and writes
+DIR/error_vs_time.png atomically (via DIR/error_vs_time.png.tmp.png): RMSE
+against the ground truth over render seconds, log-log, one curve per method
+(geometry's samples-per-pixel sweep, the reference's voxel-size sweep, the
+multiscale points labelled L1/L2/L3/auto). The ground truth's own row (error
+0 by definition) is left out; its time is drawn as a vertical line.
+"""
+import csv
+import os
+import sys
+
+import matplotlib
+matplotlib.use(os.environ.get("MPLBACKEND", "Agg"))
+import matplotlib.pyplot as plt  # noqa: E402
+
+STYLE = {
+    "geometry": ("tab:blue", "o", "geometry (explicit needles), spp"),
+    "reference": ("tab:orange", "s", "reference (OpenVDB, eq. 7), voxel"),
+    "multiscale": ("tab:green", "D", "multiscale (closed forms)"),
+}
+
+
+def fail(msg):
+    sys.exit(f"plot_compare: {msg}")
+
+
+def load(directory):
+    path = os.path.join(directory, "report.csv")
+    try:
+        with open(path, newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    except OSError as exc:
+        fail(f"cannot read {path}: {exc.strerror}")
+    for column in ("method", "setting", "seconds", "rmse"):
+        if not rows or column not in rows[0]:
+            fail(f"{path}: no rows or no column {column}")
+    return rows
+
+
+def main():
+    if len(sys.argv) != 2:
+        fail("usage: plot_compare.py DIR")
+    directory = sys.argv[1]
+    rows = load(directory)
+    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    for method, (colour, marker, label) in STYLE.items():
+        points = [(float(r["seconds"]), float(r["rmse"]), r["setting"])
+                  for r in rows if r["method"] == method]
+        # A log axis cannot show zero error; such a point would be the truth itself.
+        points = sorted(p for p in points if p[0] > 0 and p[1] > 0)
+        if not points:
+            continue
+        xs, ys, names = zip(*points)
+        line = "none" if method == "multiscale" else "-"
+        ax.plot(xs, ys, marker=marker, color=colour, linestyle=line, label=label)
+        for x, y, name in points:
+            # "auto" equals one forced level in most views: put it below, the rest above.
+            offset = (5, -11) if name == "auto" else (5, 4)
+            ax.annotate(name, (x, y), textcoords="offset points", xytext=offset,
+                        fontsize=8, color=colour)
+    for r in rows:
+        if r["method"] == "truth":
+            ax.axvline(float(r["seconds"]), color="grey", linestyle=":", linewidth=1)
+            ax.annotate(f"ground truth ({r['setting']})", (float(r["seconds"]), 1.0),
+                        xycoords=("data", "axes fraction"), xytext=(-4, -12),
+                        textcoords="offset points", ha="right", fontsize=8, color="grey")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("render seconds (wall clock, preparation included)")
+    ax.set_ylabel("RMSE of luminance against the ground truth")
+    ax.set_title("What accuracy costs in time")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    out = os.path.join(directory, "error_vs_time.png")
+    tmp = out + ".tmp.png"
+    fig.savefig(tmp, dpi=120)
+    os.replace(tmp, out)
+
+
+if __name__ == "__main__":
+    main()
