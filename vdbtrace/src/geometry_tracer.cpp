@@ -12,12 +12,12 @@
 
 #include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/ground_hit.h"
+#include "pine/vdbtrace/tiled_render.h"
 #include "pine/vdbtrace/needle_layout.h"
 
 #include <embree3/rtcore.h>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
@@ -25,7 +25,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -483,22 +482,15 @@ RenderResult renderGeometry(const TracedScene& scene, const GeometryOptions& opt
     Image& image = result.image;
     for (const char* name : {"level", "depth", "diffuse", "specular", "foliage"}) image.aov(name);
 
-    const int tile = std::max(1, options.tileSize);
-    const int tilesX = (camera.width() + tile - 1) / tile;
-    const int tilesY = (camera.height() + tile - 1) / tile;
-    const int tiles = tilesX * tilesY;
     // A sample is a point: its cone is as narrow as a sample's share of the pixel (only the
     // ground test reads the ray, and only its axis).
     const double sampleWidth = 1.0 / std::sqrt(double(samples));
-    std::mutex statsMutex;
-    std::atomic<int> done{0}, reported{0};
-    tbb::parallel_for(0, tiles, [&](int k) {
-        RenderStats stats;
+    forEachTile(camera.width(), camera.height(), options.tileSize, options.progress, result.stats,
+                [&](int x0, int y0, int x1, int y1, RenderStats& stats) {
         SampleTracer tracer(scene, plan, embree, branches, needles, stats);
         std::vector<double> depths;
-        const int x0 = (k % tilesX) * tile, y0 = (k / tilesX) * tile;
-        for (int y = y0; y < std::min(y0 + tile, camera.height()); ++y) {
-            for (int x = x0; x < std::min(x0 + tile, camera.width()); ++x) {
+        for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; ++x) {
                 const auto t0 = Clock::now();
                 const std::uint64_t key = mix((std::uint64_t(options.sampleSeed) << 48) ^
                                               (std::uint64_t(std::uint32_t(y)) << 24) ^
@@ -545,18 +537,6 @@ RenderResult renderGeometry(const TracedScene& scene, const GeometryOptions& opt
                     std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0)
                         .count());
             }
-        }
-        {
-            std::lock_guard<std::mutex> lock(statsMutex);
-            result.stats += stats;
-        }
-        const int finished = ++done;
-        if (options.progress) {
-            const int percent = finished * 50 / tiles;  // steps of 2%
-            int last = reported.load();
-            while (percent > last && !reported.compare_exchange_weak(last, percent)) {
-            }
-            if (percent > last) options.progress(double(finished) / tiles);
         }
     });
     result.seconds = std::chrono::duration<double>(Clock::now() - start).count();

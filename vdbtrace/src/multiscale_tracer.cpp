@@ -4,15 +4,13 @@
 #include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/ground_hit.h"
 #include "pine/vdbtrace/needle_layout.h"
+#include "pine/vdbtrace/tiled_render.h"
 
 #include <glm/geometric.hpp>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <mutex>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -418,18 +416,11 @@ RenderResult renderMultiscale(const TracedScene& scene, const RenderOptions& opt
     Image& image = result.image;
     for (const char* name : {"level", "depth", "diffuse", "specular", "foliage"}) image.aov(name);
 
-    const int tile = std::max(1, options.tileSize);
-    const int tilesX = (camera.width() + tile - 1) / tile, tilesY = (camera.height() + tile - 1) / tile;
-    const int tiles = tilesX * tilesY;
-    std::mutex statsMutex;
-    std::atomic<int> done{0};
-    std::atomic<int> reported{0};
-    tbb::parallel_for(0, tiles, [&](int k) {
-        RenderStats stats;
+    forEachTile(camera.width(), camera.height(), options.tileSize, options.progress, result.stats,
+                [&](int x0, int y0, int x1, int y1, RenderStats& stats) {
         PixelTracer tracer(scene, plan, options.forceLevel, stats);
-        const int x0 = (k % tilesX) * tile, y0 = (k / tilesX) * tile;
-        for (int y = y0; y < std::min(y0 + tile, camera.height()); ++y) {
-            for (int x = x0; x < std::min(x0 + tile, camera.width()); ++x) {
+        for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; ++x) {
                 const auto t0 = Clock::now();
                 const std::size_t i = std::size_t(y) * camera.width() + x;
                 tracer.trace(camera.cone(x, y), image.pixel(x, y), image.aovs["level"][i],
@@ -440,18 +431,6 @@ RenderResult renderMultiscale(const TracedScene& scene, const RenderOptions& opt
                 stats.nanosecondsPerLevel[dominant] += std::uint64_t(
                     std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count());
             }
-        }
-        {
-            std::lock_guard<std::mutex> lock(statsMutex);
-            result.stats += stats;
-        }
-        const int finished = ++done;
-        if (options.progress) {
-            const int percent = finished * 50 / tiles;  // steps of 2%
-            int last = reported.load();
-            while (percent > last && !reported.compare_exchange_weak(last, percent)) {
-            }
-            if (percent > last) options.progress(double(finished) / tiles);
         }
     });
     result.seconds = std::chrono::duration<double>(Clock::now() - start).count();

@@ -3,18 +3,16 @@
 #include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/ground_hit.h"
+#include "pine/vdbtrace/tiled_render.h"
 
 #include <glm/geometric.hpp>
 #include <openvdb/tools/RayIntersector.h>
 #include <openvdb/tree/LeafManager.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -401,27 +399,15 @@ RenderResult renderReference(const TracedScene& scene, const bake::TreeGrids& gr
     Image& image = result.image;
     for (const char* name : {"level", "depth", "diffuse", "specular", "foliage"}) image.aov(name);
 
-    std::mutex statsMutex;
-    std::atomic<int> rowsDone{0}, reported{0};
-    tbb::parallel_for(0, camera.height(), [&](int y) {
-        RenderStats stats;
-        for (int x = 0; x < camera.width(); ++x) {
-            const std::size_t i = std::size_t(y) * camera.width() + x;
-            tracer.tracePixel(camera, x, y, options.subpixels, image.pixel(x, y),
-                              image.aovs["depth"][i], image.aovs["diffuse"][i],
-                              image.aovs["specular"][i], image.aovs["foliage"][i], stats);
-        }
-        {
-            std::lock_guard<std::mutex> lock(statsMutex);
-            result.stats += stats;
-        }
-        const int finished = ++rowsDone;
-        if (options.progress) {
-            const int percent = finished * 50 / camera.height();
-            int last = reported.load();
-            while (percent > last && !reported.compare_exchange_weak(last, percent)) {
+    forEachTile(camera.width(), camera.height(), 16, options.progress, result.stats,
+                [&](int x0, int y0, int x1, int y1, RenderStats& stats) {
+        for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; ++x) {
+                const std::size_t i = std::size_t(y) * camera.width() + x;
+                tracer.tracePixel(camera, x, y, options.subpixels, image.pixel(x, y),
+                                  image.aovs["depth"][i], image.aovs["diffuse"][i],
+                                  image.aovs["specular"][i], image.aovs["foliage"][i], stats);
             }
-            if (percent > last) options.progress(double(finished) / camera.height());
         }
     });
     result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
