@@ -11,13 +11,7 @@
 namespace pine::analytic {
 namespace {
 
-BoughGeometry paperBough()
-{
-    BoughGeometry b;
-    b.cone = {kPi / 8, 4.25, 0.05, 12};
-    b.coneSpacing_cm = 0.9;
-    return b;
-}
+using test::paperBough;
 
 // A random bough with layer opacity A in [0.01, 0.9] and n A through the axis in [0.01, 5].
 BoughGeometry randomBough(test::RandomDirections& rnd)

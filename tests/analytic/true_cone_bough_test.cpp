@@ -11,13 +11,7 @@
 namespace pine::analytic {
 namespace {
 
-BoughGeometry paperBough()
-{
-    BoughGeometry b;
-    b.cone = {kPi / 8, 4.25, 0.05, 12};
-    b.coneSpacing_cm = 0.9;
-    return b;
-}
+using test::paperBough;
 
 TEST(TrueConeBough, LayersAreTheConesCountedAlongTheChord)
 {

@@ -4,6 +4,8 @@
 #include "pine/vdbtrace/compare.h"
 #include "pine/vdbtrace/flicker.h"
 
+#include "test_scenes.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -20,24 +22,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// One small fir close enough for every level (as in multiscale_tracer_test.cpp), at 48 x 36.
-const char* kFirScene = R"({
-  "name": "compare fir",
-  "camera": {"position": [0, -75, 50], "look_at": [0, 0, 40], "up": [0, 0, 1], "fov_deg": 45,
-             "resolution": [48, 36]},
-  "lights": [{"type": "directional", "direction": [0.5, -0.6, 0.8], "colour": [1, 1, 1], "irradiance": 3}],
-  "ground": {"type": "plane", "height": 0, "albedo": [0.3, 0.25, 0.2]},
-  "species": {"fir": {
-     "lsystem": {"axiom": "A", "rules": {"A": "F[&B]/[&B]/[&B]/[&B]/[&B]!A", "B": "F[+C][-C]F[+C][-C]F", "C": "F"},
-                 "iterations": 6, "branch_angle_deg": 60, "divergence_deg": 72, "segment": 8,
-                 "trunk_radius": 2, "length_decay": 0.85, "radius_decay": 0.8, "jitter_deg": 5},
-     "needles": {"base": {"aperture_deg": 22.5, "length": 4.25, "radius": 0.05, "per_cone": 12, "cone_spacing": 0.9},
-                 "tip": {"aperture_deg": 30, "length": 3.5, "radius": 0.05, "per_cone": 12, "cone_spacing": 0.9}},
-     "bark_albedo": 0.25, "needle_albedo": 0.3, "needle_specular": 0.2, "specular_exponent": 80}},
-  "trees": [{"species": "fir", "position": [0, 0], "seed": 3}],
-  "effects": ["diffuse", "specular", "shadows", "self_shadowing"],
-  "render": {"needle_level_max": 0.8, "cone_level_max": 1.3}
-})";
+// The tracer tests' fir at 48 x 36, every effect on.
+const std::string kFirScene =
+    test::firScene(R"("diffuse", "specular", "shadows", "self_shadowing")", 48, 36);
 
 using Table = std::vector<std::map<std::string, std::string>>;
 
