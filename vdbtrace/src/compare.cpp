@@ -56,23 +56,6 @@ std::string num(double v, int digits = 4)
     return s.str();
 }
 
-/// Same contract as writeJsonAtomically: a temporary name in the same folder, then renamed.
-void writeTextAtomically(const std::string& text, const fs::path& path)
-{
-    const fs::path tmp = path.string() + ".tmp" + std::to_string(std::random_device{}());
-    {
-        std::ofstream out(tmp);
-        out << text;
-        out.close();
-        if (!out) {
-            std::error_code ec;
-            fs::remove(tmp, ec);
-            throw ImageError("cannot write " + path.string());
-        }
-    }
-    fs::rename(tmp, path);
-}
-
 bool canWriteInto(const fs::path& dir)
 {
     std::error_code ec;

@@ -37,13 +37,12 @@ nlohmann::json toJson(const EffectsPlan& p)
             {"self_shadowing", p.selfShadowing}};
 }
 
-void writeJsonAtomically(const nlohmann::json& json, const std::filesystem::path& path)
+void writeTextAtomically(const std::string& text, const std::filesystem::path& path)
 {
-    const std::filesystem::path tmp =
-        path.string() + ".tmp" + std::to_string(std::random_device{}()) + ".json";
+    const std::filesystem::path tmp = path.string() + ".tmp" + std::to_string(std::random_device{}());
     {
         std::ofstream out(tmp);
-        out << json.dump(2) << '\n';
+        out << text;
         out.close();
         if (!out) {
             std::error_code ec;
@@ -52,6 +51,11 @@ void writeJsonAtomically(const nlohmann::json& json, const std::filesystem::path
         }
     }
     std::filesystem::rename(tmp, path);
+}
+
+void writeJsonAtomically(const nlohmann::json& json, const std::filesystem::path& path)
+{
+    writeTextAtomically(json.dump(2) + "\n", path);
 }
 
 }  // namespace pine::vdbtrace

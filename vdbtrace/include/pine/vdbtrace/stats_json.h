@@ -6,13 +6,18 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <string>
 
 namespace pine::vdbtrace {
 
 nlohmann::json toJson(const RenderStats& stats);
 nlohmann::json toJson(const EffectsPlan& plan);
 
-/// Writes `json` to `path` through a temporary file in the same folder, then renames it.
+/// Writes `text` to `path` through a temporary file in the same folder, then renames it: a
+/// reader never sees a half-written file. Throws ImageError naming the path.
+void writeTextAtomically(const std::string& text, const std::filesystem::path& path);
+
+/// The same for JSON, indented.
 void writeJsonAtomically(const nlohmann::json& json, const std::filesystem::path& path);
 
 }  // namespace pine::vdbtrace
