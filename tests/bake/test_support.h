@@ -1,6 +1,8 @@
 // Shared by the bake tests: fresh temporary folders and boughs of the paper's parameters.
 #pragma once
 
+#include "../support/temp_dir.h"
+
 #include "pine/bake/layer_field.h"
 
 #include <glm/geometric.hpp>
@@ -13,28 +15,10 @@
 
 namespace pine::bake::test {
 
-/// A fresh folder under the system's temporary directory, removed with its contents.
-class TempDir {
+/// A fresh folder per test (tests/support/temp_dir.h), named for this suite.
+class TempDir : public pine::test::TempDir {
 public:
-    TempDir()
-    {
-        std::string pattern =
-            (std::filesystem::temp_directory_path() / "pine-bake-test-XXXXXX").string();
-        if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-        mPath = pattern;
-    }
-    ~TempDir()
-    {
-        std::error_code ec;
-        std::filesystem::remove_all(mPath, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-
-    const std::filesystem::path& path() const { return mPath; }
-
-private:
-    std::filesystem::path mPath;
+    TempDir() : pine::test::TempDir("pine-bake-test") {}
 };
 
 /// The paper's benchmark bough (section 7: N = 12, r = 0.05, l = 4.25, phi = pi/8, dh = 0.9;

@@ -1,6 +1,8 @@
 // Shared by the scenes tests: a complete scene to mutate, error capture and temporary folders.
 #pragma once
 
+#include "../support/temp_dir.h"
+
 #include "pine/scenes/scene.h"
 
 #include <gtest/gtest.h>
@@ -71,34 +73,10 @@ inline std::string errorOfText(const std::string& text,
 }
 inline std::string errorOf(const json& j) { return errorOfText(j.dump(2)); }
 
-/// A fresh folder under the system's temporary directory, removed with its contents.
-class TempDir {
+/// A fresh folder per test (tests/support/temp_dir.h), named for this suite.
+class TempDir : public pine::test::TempDir {
 public:
-    TempDir()
-    {
-        std::string pattern =
-            (std::filesystem::temp_directory_path() / "pine-scenes-test-XXXXXX").string();
-        if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-        mPath = pattern;
-    }
-    ~TempDir()
-    {
-        std::error_code ec;
-        std::filesystem::remove_all(mPath, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-
-    const std::filesystem::path& path() const { return mPath; }
-    std::filesystem::path write(const std::string& name, const std::string& text) const
-    {
-        const auto file = mPath / name;
-        std::ofstream(file) << text;
-        return file;
-    }
-
-private:
-    std::filesystem::path mPath;
+    TempDir() : pine::test::TempDir("pine-scenes-test") {}
 };
 
 }  // namespace pine::scenes::test

@@ -4,21 +4,9 @@
 set -u
 vdbtrace=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-
-# expect_error NAME STATUS PATTERN -- ARGS...: exits STATUS, one stderr line matching PATTERN.
-expect_error() {
-    local name=$1 status=$2 pattern=$3
-    shift 4
-    "$vdbtrace" "$@" >"$work/out" 2>"$work/err"
-    local got=$?
-    [ "$got" -eq "$status" ] || fail "$name: exit $got, expected $status"
-    [ "$(wc -l <"$work/err")" -eq 1 ] || fail "$name: stderr is not one line: $(cat "$work/err")"
-    grep -q -- "$pattern" "$work/err" || fail "$name: stderr lacks '$pattern': $(cat "$work/err")"
-}
+tool=$vdbtrace
+# shellcheck source=cli_test_lib.sh
+source "$(dirname "$0")/cli_test_lib.sh"
 
 expect_error "missing scene" 2 "missing.json" -- render "$work/missing.json" --out "$work/a.exr"
 printf '{"camera": {' >"$work/broken.json"

@@ -145,6 +145,27 @@ struct HandMade {
     }
 };
 
+// One hand-made bough of `cone` needles, 5 cm along x, side-on at 15 cm, rendered by the
+// multiscale level 1 and by the geometry at 64 samples: their foliage AOVs.
+struct SideOnCoverage {
+    RenderResult level1, geometry;
+};
+
+SideOnCoverage renderSideOnBough(const analytic::ConeGeometry& cone, unsigned seed)
+{
+    HandMade s(R"({"position": [0, -15, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
+                   "fov_deg": 30, "resolution": [120, 90]})",
+               "[0.2, -1, 0.5]");
+    s.add(Vec3(-5, 0, 0), Vec3(1, 0, 0), 5.0, cone, seed);
+    const TracedBough& b = s.traced.boughs.front();
+    s.traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
+    RenderOptions level1;
+    level1.forceLevel = 1;
+    GeometryOptions options;
+    options.samples = 64;
+    return {renderMultiscale(s.traced, level1), renderGeometry(s.traced, options)};
+}
+
 TEST(GeometryTracer, CoversWhatTheMultiscaleNeedleLevelCovers)
 {
     // A thin bough, 6 cones of 12 needles, side-on at 15 cm: needles ~40 pixels long, about
@@ -161,21 +182,11 @@ TEST(GeometryTracer, CoversWhatTheMultiscaleNeedleLevelCovers)
     // strip has not (pi r^2 / (2 r l) < 2%, only end-on), and overlaps (level 1 composites
     // a pixel's needles as independent, 1 - prod(1 - c_i); the geometry's union is exact).
     // 64 samples leave a sampling error of the total well under 1%.
-    HandMade s(R"({"position": [0, -15, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
-                   "fov_deg": 30, "resolution": [120, 90]})",
-               "[0.2, -1, 0.5]");
     const analytic::ConeGeometry cone{analytic::kPi / 8, 4.25, 0.05, 12};
-    s.add(Vec3(-5, 0, 0), Vec3(1, 0, 0), 5.0, cone, 11);
-    const TracedBough& b = s.traced.boughs.front();
-    s.traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
-    RenderOptions level1;
-    level1.forceLevel = 1;
-    const RenderResult multiscale = renderMultiscale(s.traced, level1);
-    GeometryOptions options;
-    options.samples = 64;
-    const RenderResult geometry = renderGeometry(s.traced, options);
-    s.traced.boughs.front().seed += 1;
-    const RenderResult rolled = renderGeometry(s.traced, options);
+    const SideOnCoverage run = renderSideOnBough(cone, 11);
+    const RenderResult& multiscale = run.level1;
+    const RenderResult& geometry = run.geometry;
+    const RenderResult rolled = renderSideOnBough(cone, 12).geometry;
     const std::vector<float>& m = multiscale.image.aovs.at("foliage");
     const std::vector<float>& g = geometry.image.aovs.at("foliage");
     const std::vector<float>& o = rolled.image.aovs.at("foliage");
@@ -203,21 +214,11 @@ TEST(GeometryTracer, NeedleLevelCountsEachNeedleOnceWhenConesAreSparse)
     // geometry does (26.7 against 13.1 pixels before the fix). Each needle once: the ratio
     // stays under the same 4% as with 12 needles, and above what a needle lost near a cone's
     // silhouette (up to half of it) can take away.
-    HandMade s(R"({"position": [0, -15, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
-                   "fov_deg": 30, "resolution": [120, 90]})",
-               "[0.2, -1, 0.5]");
     for (const double perCone : {1.0, 2.0}) {
-        s.traced.boughs.clear();
         const analytic::ConeGeometry cone{analytic::kPi / 8, 4.25, 0.05, perCone};
-        s.add(Vec3(-5, 0, 0), Vec3(1, 0, 0), 5.0, cone, 11);
-        const TracedBough& b = s.traced.boughs.front();
-        s.traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
-        RenderOptions level1;
-        level1.forceLevel = 1;
-        const RenderResult multiscale = renderMultiscale(s.traced, level1);
-        GeometryOptions options;
-        options.samples = 64;
-        const RenderResult geometry = renderGeometry(s.traced, options);
+        const SideOnCoverage run = renderSideOnBough(cone, 11);
+        const RenderResult& multiscale = run.level1;
+        const RenderResult& geometry = run.geometry;
         double covered[2] = {0.0, 0.0};
         for (std::size_t i = 0; i < geometry.image.aovs.at("foliage").size(); ++i) {
             covered[0] += multiscale.image.aovs.at("foliage")[i];
