@@ -70,15 +70,16 @@ BENCHMARK(NeedleDiffuse_Quadrature);
 
 void Cone_Eqs4to6(benchmark::State& state)
 {
-    overTriples(state,
-                [](const Triple& t) { return coneIntegrals(kPi / 8, t.axis, t.L, t.V, kExponent); });
+    overTriples(
+        state, [](const Triple& t) { return coneIntegrals(kPi / 8, t.axis, t.L, t.V, kExponent); });
 }
 BENCHMARK(Cone_Eqs4to6);
 
 void Cone_PrintedLambdaFit(benchmark::State& state)
 {
-    overTriples(state,
-                [](const Triple& t) { return coneDiffuseLambdaFit(kPi / 8, t.axis, t.L, t.V, true); });
+    overTriples(state, [](const Triple& t) {
+        return coneDiffuseLambdaFit(kPi / 8, t.axis, t.L, t.V, true);
+    });
 }
 BENCHMARK(Cone_PrintedLambdaFit);
 

@@ -78,7 +78,8 @@ BoughLinearLaw boughLinearLaw(const BoughGeometry& bough, const BoughView& view)
     const FrontRear& v = law.alphaView;
     const FrontRear& l = law.alphaLight;
     const FrontRear kept = brackets(v.front, v.rear, l.front, l.rear);
-    law.transfer = {v.front * std::clamp(kept.front, 0.0, 1.0), v.rear * std::clamp(kept.rear, 0.0, 1.0)};
+    law.transfer = {v.front * std::clamp(kept.front, 0.0, 1.0),
+                    v.rear * std::clamp(kept.rear, 0.0, 1.0)};
     const double fv = law.a * view.kV, rv = law.a * view.kVbar;
     const FrontRear raw = brackets(fv, rv, law.a * view.kL, law.a * view.kLbar);
     law.transferUnclamped = {fv * raw.front, rv * raw.rear};

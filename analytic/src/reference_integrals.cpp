@@ -62,7 +62,10 @@ struct DiskFrame {
     /// The zeta on chord xi where the shadow chord changes halves (u = 0): a kink.
     double kink(double xi) const { return std::abs(cl) > 1e-12 ? -xi * sl / cl : 2.0; }
     /// Chord offsets where that kink enters or leaves a half chord: kinks of the outer integral.
-    std::vector<double> chordBreaks() const { return {-1.0, -std::abs(cl), 0.0, std::abs(cl), 1.0}; }
+    std::vector<double> chordBreaks() const
+    {
+        return {-1.0, -std::abs(cl), 0.0, std::abs(cl), 1.0};
+    }
 };
 
 double halfChordRho(double xi) { return std::sqrt(std::max(0.0, 1.0 - xi * xi)); }
@@ -74,7 +77,8 @@ double overHalfChord(const std::function<double(double)>& f, const DiskFrame& di
 {
     const double rho = halfChordRho(xi);
     const double a = front ? 0.0 : -rho, b = front ? rho : 0.0, k = disk.kink(xi);
-    if (k > a && k < b) return integrateAdaptive(f, a, k, absTol) + integrateAdaptive(f, k, b, absTol);
+    if (k > a && k < b)
+        return integrateAdaptive(f, a, k, absTol) + integrateAdaptive(f, k, b, absTol);
     return integrateAdaptive(f, a, b, absTol);
 }
 
@@ -128,7 +132,9 @@ ConeIntegrals coneIntegrals(double aperture_rad, const Vec3& axis, const Vec3& L
 {
     const ConeFrame f = coneFrame(aperture_rad, axis, L, V);
     const auto sv = [&](double t) { return projectOnAxis(f.needle(t), V).s; };
-    const auto g = [&](double t) { return 4.0 * sv(t) * analytic::needleDiffuse(f.needle(t), L, V); };
+    const auto g = [&](double t) {
+        return 4.0 * sv(t) * analytic::needleDiffuse(f.needle(t), L, V);
+    };
     const auto s = [&](double t) {
         return 2.0 * sv(t) * analytic::needleSpecular(f.needle(t), L, V, exponent) /
                std::sqrt(2.0 * kPi / exponent);

@@ -100,7 +100,8 @@ ConeGeometry readCone(CaseReader& r)
 json evaluateNeedle(CaseReader& r, const Vec3& axis, const Vec3& L, const Vec3& V)
 {
     const double n = r.number("exponent", 0.0, true);
-    json out = {{"diffuse", needleDiffuse(axis, L, V)}, {"specular", needleSpecular(axis, L, V, n)}};
+    json out = {{"diffuse", needleDiffuse(axis, L, V)},
+                {"specular", needleSpecular(axis, L, V, n)}};
     if (r.has("radius") || r.has("length")) {
         const double area =
             needleProjectedArea(axis, V, r.number("radius", 0.0), r.number("length", 0.0));
@@ -117,7 +118,8 @@ json evaluateCone(CaseReader& r, const Vec3& axis, const Vec3& L, const Vec3& V)
     const ConeGeometry cone = readCone(r);
     const double n = r.number("exponent", 1.0, true);
     const double R = boughRadius(cone);
-    const double footprint = r.has("footprint_area") ? r.number("footprint_area", 0.0) : kPi * R * R;
+    const double footprint =
+        r.has("footprint_area") ? r.number("footprint_area", 0.0) : kPi * R * R;
     const ConeSums sums = coneSums(cone, coneIntegrals(cone.aperture_rad, axis, L, V, n), n);
     const ConeShading s = shadeCone(sums, footprint);
     return {{"A", layerOpacity(cone)},           {"R", R},

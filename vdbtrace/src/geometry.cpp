@@ -68,8 +68,10 @@ bool intersectCylinder(const ConeRay& ray, const Vec3& a, const Vec3& b, double 
     const Vec3 m = ray.origin - a;
     const Vec3 dp = ray.direction - glm::dot(ray.direction, u) * u;
     const Vec3 mp = m - glm::dot(m, u) * u;
-    const double A = glm::dot(dp, dp), B = 2.0 * glm::dot(dp, mp), C = glm::dot(mp, mp) - radius * radius;
-    double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
+    const double A = glm::dot(dp, dp), B = 2.0 * glm::dot(dp, mp),
+                 C = glm::dot(mp, mp) - radius * radius;
+    double t0 = -std::numeric_limits<double>::infinity(),
+           t1 = std::numeric_limits<double>::infinity();
     if (A > 1e-300) {
         const double disc = B * B - 4.0 * A * C;
         if (disc < 0.0) return false;

@@ -11,7 +11,8 @@ double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722
 // A perceptually ordered ramp: black, blue, green, yellow, white at 0, .25, .5, .75, 1.
 void ramp(double v, float* rgb)
 {
-    static const float stops[5][3] = {{0, 0, 0}, {0.1f, 0.2f, 1}, {0.1f, 0.8f, 0.2f}, {1, 0.9f, 0.1f}, {1, 1, 1}};
+    static const float stops[5][3] = {
+        {0, 0, 0}, {0.1f, 0.2f, 1}, {0.1f, 0.8f, 0.2f}, {1, 0.9f, 0.1f}, {1, 1, 1}};
     v = std::clamp(v, 0.0, 1.0) * 4.0;
     const int i = std::min(3, int(v));
     const double f = v - i;

@@ -31,8 +31,12 @@ double luminance(const Vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * 
 
 class PixelTracer {
 public:
-    PixelTracer(const TracedScene& scene, const EffectsPlan& plan, int forceLevel, RenderStats& stats)
-        : mScene(scene), mPlan(plan), mSettings(scene.scene->render), mForceLevel(forceLevel),
+    PixelTracer(const TracedScene& scene, const EffectsPlan& plan, int forceLevel,
+                RenderStats& stats)
+        : mScene(scene),
+          mPlan(plan),
+          mSettings(scene.scene->render),
+          mForceLevel(forceLevel),
           mStats(stats)
     {
     }
@@ -141,7 +145,8 @@ double PixelTracer::selfShadow(const TracedBough& b, const Vec3& x, const Vec3& 
     ConeRay ray{x, towardsLight, 0.0};
     double tIn, tOut;
     if (!intersectCylinder(ray, b.base_cm, b.conesEnd_cm, b.radius_cm, tIn, tOut)) return 1.0;
-    const double dh = b.geometry.coneSpacing_cm, cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad);
+    const double dh = b.geometry.coneSpacing_cm,
+                 cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad);
     const auto g = [&](double t) {
         const Vec3 r = ray.origin + t * ray.direction - b.base_cm;
         const double h = glm::dot(r, b.axis);
@@ -155,7 +160,8 @@ double PixelTracer::selfShadow(const TracedBough& b, const Vec3& x, const Vec3& 
         t1 = std::min(t1, tOut);
         const double g1 = g(t1);
         const long j0 = long(std::floor(g0 / dh)), j1 = long(std::floor(g1 / dh));
-        for (long j = std::min(j0, j1) + 1; j <= std::max(j0, j1); ++j) count += (j >= 0 && j <= jMax);
+        for (long j = std::min(j0, j1) + 1; j <= std::max(j0, j1); ++j)
+            count += (j >= 0 && j <= jMax);
         g0 = g1;
         if (t1 >= tOut) break;
     }
@@ -171,7 +177,8 @@ void PixelTracer::shadeNeedle(const TracedBough& b, const Vec3& needle, const Ve
         const double self = mPlan.selfShadowing ? selfShadow(b, x, towards[i]) : 1.0;
         const Vec3 E = irradiance[i] * self;
         if (mPlan.diffuse) {
-            layer.diffuse += alpha * b.needleAlbedo / kPi * E * analytic::needleDiffuse(needle, towards[i], V);
+            layer.diffuse +=
+                alpha * b.needleAlbedo / kPi * E * analytic::needleDiffuse(needle, towards[i], V);
             ++mStats.diffuseEvaluations;
         }
         if (mPlan.specular) {
@@ -342,7 +349,8 @@ void PixelTracer::trace(const ConeRay& ray, float* rgba, float& level, float& de
         mLayers.push_back(layer);
     }
 
-    std::sort(mLayers.begin(), mLayers.end(), [](const Layer& a, const Layer& b) { return a.t < b.t; });
+    std::sort(mLayers.begin(), mLayers.end(),
+              [](const Layer& a, const Layer& b) { return a.t < b.t; });
     double A = 0.0, levelSum = 0.0, foliage = 0.0, levelWeight[4] = {0, 0, 0, 0};
     Vec3 diffuse(0.0), specular(0.0);
     depth = 0.0f;
@@ -429,7 +437,8 @@ RenderResult renderMultiscale(const TracedScene& scene, const RenderOptions& opt
                 const int dominant = tracer.dominantLevel();
                 ++stats.pixelsPerLevel[dominant];
                 stats.nanosecondsPerLevel[dominant] += std::uint64_t(
-                    std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count());
+                    std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0)
+                        .count());
             }
         }
     });

@@ -64,8 +64,10 @@ struct FieldReader {
     openvdb::Vec3SGrid::ConstAccessor gradient, needle, albedo;
     openvdb::FloatGrid::ConstAccessor opacity;
     explicit FieldReader(const bake::TreeGrids& g)
-        : gradient(g.layerGradient->getConstAccessor()), needle(g.needleDirection->getConstAccessor()),
-          albedo(g.needleAlbedo->getConstAccessor()), opacity(g.layerOpacity->getConstAccessor())
+        : gradient(g.layerGradient->getConstAccessor()),
+          needle(g.needleDirection->getConstAccessor()),
+          albedo(g.needleAlbedo->getConstAccessor()),
+          opacity(g.layerOpacity->getConstAccessor())
     {
     }
     /// -ln(1 - A) |d . G| at voxel ijk, per cm; 0 outside the boughs.
@@ -315,7 +317,8 @@ void ReferenceTracer::tracePixel(const ConeCamera& camera, int x, int y, int sub
                       if (sigma > 0.0) {
                           const Vec3 needle = toGlm(field.needle.getValue(ijk));
                           const Vec3 albedo = toGlm(field.albedo.getValue(ijk));
-                          const openvdb::Vec3d c = mGrids.layerOpacity->transform().indexToWorld(ijk);
+                          const openvdb::Vec3d c =
+                              mGrids.layerOpacity->transform().indexToWorld(ijk);
                           const Vec3 centre(c.x(), c.y(), c.z());
                           for (std::size_t i = 0; i < mScene.lights.size(); ++i) {
                               Vec3 L, E;
@@ -357,8 +360,10 @@ void ReferenceTracer::tracePixel(const ConeCamera& camera, int x, int y, int sub
     rgba[2] = float(colour.z);
     rgba[3] = float(sumAlpha * w);
     depthOut = float(sumDepth * w);
-    diffuseOut = float(0.2126 * sumDiffuse.x * w + 0.7152 * sumDiffuse.y * w + 0.0722 * sumDiffuse.z * w);
-    specularOut = float(0.2126 * sumSpecular.x * w + 0.7152 * sumSpecular.y * w + 0.0722 * sumSpecular.z * w);
+    diffuseOut =
+        float(0.2126 * sumDiffuse.x * w + 0.7152 * sumDiffuse.y * w + 0.0722 * sumDiffuse.z * w);
+    specularOut =
+        float(0.2126 * sumSpecular.x * w + 0.7152 * sumSpecular.y * w + 0.0722 * sumSpecular.z * w);
     foliageOut = float(sumFoliage * w);
 }
 

@@ -15,18 +15,20 @@ nlohmann::json toJson(const RenderStats& s)
         pixels[levels[k]] = s.pixelsPerLevel[k];
         seconds[levels[k]] = double(s.nanosecondsPerLevel[k]) * 1e-9;
     }
-    return {{"cone_rays", s.coneRays},
-            {"shadow_rays", s.shadowRays},
-            {"self_shadow_evaluations", s.selfShadowEvaluations},
-            {"hits", {{"needle", s.needleHits},
-                      {"cone", s.coneHits},
-                      {"bough", s.boughHits},
-                      {"branch", s.branchHits},
-                      {"ground", s.groundHits}}},
-            {"voxel_spans", s.voxelSpans},
-            {"evaluations", {{"diffuse", s.diffuseEvaluations}, {"specular", s.specularEvaluations}}},
-            {"pixels_per_level", pixels},
-            {"thread_seconds_per_level", seconds}};
+    return {
+        {"cone_rays", s.coneRays},
+        {"shadow_rays", s.shadowRays},
+        {"self_shadow_evaluations", s.selfShadowEvaluations},
+        {"hits",
+         {{"needle", s.needleHits},
+          {"cone", s.coneHits},
+          {"bough", s.boughHits},
+          {"branch", s.branchHits},
+          {"ground", s.groundHits}}},
+        {"voxel_spans", s.voxelSpans},
+        {"evaluations", {{"diffuse", s.diffuseEvaluations}, {"specular", s.specularEvaluations}}},
+        {"pixels_per_level", pixels},
+        {"thread_seconds_per_level", seconds}};
 }
 
 nlohmann::json toJson(const EffectsPlan& p)
@@ -39,7 +41,8 @@ nlohmann::json toJson(const EffectsPlan& p)
 
 void writeTextAtomically(const std::string& text, const std::filesystem::path& path)
 {
-    const std::filesystem::path tmp = path.string() + ".tmp" + std::to_string(std::random_device{}());
+    const std::filesystem::path tmp =
+        path.string() + ".tmp" + std::to_string(std::random_device{}());
     {
         std::ofstream out(tmp);
         out << text;

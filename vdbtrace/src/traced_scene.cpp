@@ -98,7 +98,8 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
         const scenes::Tree& tree = out.trees[i];
         const scenes::Species& species = *tree.species;
         for (const scenes::Segment& s : tree.segments) {
-            out.branches.push_back({s.base_cm, s.tip_cm, s.radius_cm, hued(kBarkHue, species.barkAlbedo)});
+            out.branches.push_back(
+                {s.base_cm, s.tip_cm, s.radius_cm, hued(kBarkHue, species.barkAlbedo)});
         }
         for (std::size_t j = 0; j < tree.boughs.size(); ++j) {
             const scenes::Bough& b = tree.boughs[j];
@@ -129,7 +130,9 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
         const Vec3 centre = 0.5 * (b.base_cm + b.tip_cm);
         const Vec3 V = glm::normalize(eye - centre);
         const double phiAperture = b.geometry.cone.aperture_rad;
-        b.alpha = analytic::boughLinearLaw(b.geometry, analytic::boughView(phiAperture, b.axis, V, V)).alphaView;
+        b.alpha =
+            analytic::boughLinearLaw(b.geometry, analytic::boughView(phiAperture, b.axis, V, V))
+                .alphaView;
         for (const Light& light : out.lights) {
             Vec3 L, irradiance;
             double distance;
@@ -137,12 +140,14 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
             BoughLighting lit;
             const double phi = b.geometry.cone.aperture_rad;
             const auto sums = analytic::coneSums(
-                b.geometry.cone, analytic::coneIntegrals(phi, b.axis, L, V, b.exponent), b.exponent);
+                b.geometry.cone, analytic::coneIntegrals(phi, b.axis, L, V, b.exponent),
+                b.exponent);
             lit.front = analytic::meanReflectance(sums.front);
             lit.rear = analytic::meanReflectance(sums.rear);
             lit.view = analytic::boughView(phi, b.axis, L, V);
             lit.law = analytic::boughLinearLaw(b.geometry, lit.view);
-            const auto fromLight = analytic::boughLinearLaw(b.geometry, analytic::boughView(phi, b.axis, L, L));
+            const auto fromLight =
+                analytic::boughLinearLaw(b.geometry, analytic::boughView(phi, b.axis, L, L));
             lit.opacityFromLight = fromLight.alphaView.front + fromLight.alphaView.rear;
             b.lighting.push_back(lit);
         }

@@ -104,8 +104,8 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
         baked = bake::mergeTreeGrids(trees);
     }
     const auto loaded = load(sceneFile);
-    std::cerr << "vdbtrace: " << sceneFile.string() << ": " << describe(loaded->scene, loaded->traced)
-              << '\n';
+    std::cerr << "vdbtrace: " << sceneFile.string() << ": "
+              << describe(loaded->scene, loaded->traced) << '\n';
     vdbtrace::RenderResult result;
     if (method == "multiscale") {
         vdbtrace::RenderOptions options = withProgress("rendering");
@@ -130,10 +130,11 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
             std::cerr << "vdbtrace: baking the boughs at " << reference.voxelSize_cm << " cm\n";
             grids = vdbtrace::bakeScene(loaded->traced, reference.voxelSize_cm);
         }
-        std::cerr << "vdbtrace: " << grids.layerOpacity->activeVoxelCount() << " voxels of "
-                  << grids.voxelSize_cm << " cm in "
-                  << std::chrono::duration<double>(std::chrono::steady_clock::now() - readStart).count()
-                  << " s\n";
+        std::cerr
+            << "vdbtrace: " << grids.layerOpacity->activeVoxelCount() << " voxels of "
+            << grids.voxelSize_cm << " cm in "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - readStart).count()
+            << " s\n";
         vdbtrace::ReferenceOptions options;
         options.subpixels = reference.subpixels;
         options.progress = withProgress("rendering").progress;
@@ -272,7 +273,8 @@ int main(int argc, char** argv)
     CLI::App app{"vdbtrace: the cone tracer of Meyer & Neyret's multiscale pine shaders"};
     app.require_subcommand(1);
     int threads = 0;
-    app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+    app.add_option("--threads", threads, "Worker threads (default: all cores)")
+        ->check(CLI::NonNegativeNumber);
 
     fs::path sceneFile, out, statsFile;
     std::string method = "multiscale";
@@ -296,7 +298,8 @@ int main(int argc, char** argv)
     int samples = 16;
     renderCmd->add_option("--samples", samples, "geometry: point samples per pixel")
         ->check(CLI::Range(1, 65536));
-    renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")->required();
+    renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")
+        ->required();
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
         ->check(CLI::IsMember({"level"}));
@@ -304,7 +307,8 @@ int main(int argc, char** argv)
         ->check(CLI::Range(0, 3));
 
     bool scaling = false;
-    auto* benchCmd = app.add_subcommand("bench", "Time a render: seconds, cone rays/s, memory, levels");
+    auto* benchCmd =
+        app.add_subcommand("bench", "Time a render: seconds, cone rays/s, memory, levels");
     benchCmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
     benchCmd->add_flag("--scaling", scaling,
                        "Also render with N x 2 and dh / 2 (section 7's scaling claim)");
@@ -313,8 +317,11 @@ int main(int argc, char** argv)
     double diffScale = 0.0;
     auto* diffCmd = app.add_subcommand("diff", "Per-pixel error of IMAGE against REFERENCE");
     diffCmd->add_option("image", diffA, "EXR to judge")->required()->check(CLI::ExistingFile);
-    diffCmd->add_option("reference", diffB, "EXR taken as right")->required()->check(CLI::ExistingFile);
-    diffCmd->add_option("--out", diffOut, "Folder for error.exr, error.png, errors.json")->required();
+    diffCmd->add_option("reference", diffB, "EXR taken as right")
+        ->required()
+        ->check(CLI::ExistingFile);
+    diffCmd->add_option("--out", diffOut, "Folder for error.exr, error.png, errors.json")
+        ->required();
     diffCmd->add_option("--scale", diffScale, "Error shown white in error.png (default: the max)")
         ->check(CLI::NonNegativeNumber);
 
