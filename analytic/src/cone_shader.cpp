@@ -115,12 +115,14 @@ double boughRadius(const ConeGeometry& cone)
     return cone.needleLength_cm * std::sin(cone.aperture_rad);
 }
 
-double layerOpacity(const ConeGeometry& cone)
+double layerCoverage(const ConeGeometry& cone)
 {
     const double R = boughRadius(cone);
     if (!(R > 0.0)) return 0.0;
-    return std::clamp(2.0 * cone.needlesPerCone * cone.needleRadius_cm / (kPi * R), 0.0, 1.0);
+    return 2.0 * cone.needlesPerCone * cone.needleRadius_cm / (kPi * R);
 }
+
+double layerOpacity(const ConeGeometry& cone) { return std::clamp(layerCoverage(cone), 0.0, 1.0); }
 
 Vec3 ConeFrame::needle(double theta) const
 {

@@ -48,24 +48,23 @@ bool finite(const Vec3& v)
 
 PreparedBough::PreparedBough(const BoughSpec& spec)
 {
-    const double phi = spec.aperture_rad;
+    const analytic::ConeGeometry& cone = spec.needles.cone;
+    const double phi = cone.aperture_rad;
     if (!finite(spec.base_cm) || !finite(spec.tip_cm) || !finite(spec.needleAlbedo) ||
-        !std::isfinite(phi) || !std::isfinite(spec.needleLength_cm) ||
-        !std::isfinite(spec.needleRadius_cm) || !std::isfinite(spec.needlesPerCone) ||
-        !std::isfinite(spec.coneSpacing_cm)) {
+        !std::isfinite(phi) || !std::isfinite(cone.needleLength_cm) ||
+        !std::isfinite(cone.needleRadius_cm) || !std::isfinite(cone.needlesPerCone) ||
+        !std::isfinite(spec.needles.coneSpacing_cm)) {
         mInvalid = "a parameter is not finite";
     } else if (!(phi > 0.0 && phi <= analytic::kPi / 2)) {
         mInvalid = "aperture_rad must be in (0, pi/2]";
-    } else if (spec.needleLength_cm < 0.0 || spec.needleRadius_cm < 0.0 ||
-               spec.needlesPerCone < 0.0) {
+    } else if (cone.needleLength_cm < 0.0 || cone.needleRadius_cm < 0.0 ||
+               cone.needlesPerCone < 0.0) {
         mInvalid = "needle length, radius and count must be >= 0";
-    } else if (!(spec.coneSpacing_cm > 0.0)) {
+    } else if (!(spec.needles.coneSpacing_cm > 0.0)) {
         mInvalid = "coneSpacing_cm must be > 0";
     }
     if (mInvalid) return;
 
-    const analytic::ConeGeometry cone{phi, spec.needleLength_cm, spec.needleRadius_cm,
-                                      spec.needlesPerCone};
     mBase = spec.base_cm;
     mLength = glm::length(spec.tip_cm - spec.base_cm);
     mRadius = analytic::boughRadius(cone);      // R = l sin(phi)
@@ -73,7 +72,7 @@ PreparedBough::PreparedBough(const BoughSpec& spec)
     mCosPhi = std::cos(phi);
     mSinPhi = std::sin(phi);
     mCotPhi = mCosPhi / mSinPhi;
-    mInvSpacing = 1.0 / spec.coneSpacing_cm;
+    mInvSpacing = 1.0 / spec.needles.coneSpacing_cm;
     if (mLength > 0.0) mAxis = (spec.tip_cm - spec.base_cm) / mLength;
     mEmpty = !(mLength > 0.0 && mRadius > 0.0 && mOpacity > 0.0 && std::isfinite(mAxis.x));
 }

@@ -1,33 +1,49 @@
 #include "pine/bake/tree_boughs.h"
 
+#include "pine/scenes/colours.h"
 #include "pine/scenes/tree.h"
 
 #include <stdexcept>
 
 namespace pine::bake {
 
+analytic::BoughGeometry boughGeometry(const scenes::NeedleParameters& p)
+{
+    analytic::BoughGeometry g;
+    g.cone.aperture_rad = p.aperture_rad;
+    g.cone.needleLength_cm = p.length_cm;
+    g.cone.needleRadius_cm = p.radius_cm;
+    g.cone.needlesPerCone = p.perCone;
+    g.coneSpacing_cm = p.coneSpacing_cm;
+    return g;
+}
+
 std::vector<BoughSpec> treeBoughs(const scenes::Tree& tree)
 {
     if (!tree.species) throw std::invalid_argument("treeBoughs: the tree has no species");
-    const double grey = tree.species->needleAlbedo;
-    const Vec3 albedo = Vec3(kNeedleHue[0], kNeedleHue[1], kNeedleHue[2]) * (grey / kNeedleHue[1]);
+    const Vec3 albedo = scenes::needleColour(*tree.species);
     std::vector<BoughSpec> out;
     out.reserve(tree.boughs.size());
     for (const scenes::Bough& bough : tree.boughs) {
         const scenes::Segment& segment = tree.segments.at(bough.segment);
-        const scenes::NeedleParameters p = scenes::lerp(bough.atBase, bough.atTip, 0.5);
         BoughSpec spec;
         spec.base_cm = segment.base_cm;
         spec.tip_cm = segment.tip_cm;
-        spec.aperture_rad = p.aperture_rad;
-        spec.needleLength_cm = p.length_cm;
-        spec.needleRadius_cm = p.radius_cm;
-        spec.needlesPerCone = p.perCone;
-        spec.coneSpacing_cm = p.coneSpacing_cm;
+        spec.needles = boughGeometry(scenes::lerp(bough.atBase, bough.atTip, 0.5));
         spec.needleAlbedo = albedo;
         out.push_back(spec);
     }
     return out;
+}
+
+TreeGrids bakeScene(const std::vector<scenes::Tree>& trees, const BakeSettings& settings)
+{
+    std::vector<BoughSpec> all;
+    for (const scenes::Tree& tree : trees) {
+        const std::vector<BoughSpec> boughs = treeBoughs(tree);
+        all.insert(all.end(), boughs.begin(), boughs.end());
+    }
+    return bakeBoughs(all, settings);
 }
 
 }  // namespace pine::bake

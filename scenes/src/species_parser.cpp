@@ -2,6 +2,8 @@
 // defaults and valid ranges: docs/scene-format.md, "species".
 #include "scene_sections.h"
 
+#include "pine/analytic/cone_shader.h"
+
 #include "pine/scenes/lsystem.h"
 
 #include <cctype>
@@ -92,8 +94,8 @@ NeedleParameters readNeedles(const Json& value, const Where& where,
     }
     // Section 3.3: A = 2 N r / (pi R) is the fraction of the cone covered by needles; above 1
     // the needles of one cone overlap and no shader level describes them.
-    const double R = p.length_cm * std::sin(p.aperture_rad);
-    const double A = 2.0 * p.perCone * p.radius_cm / (std::numbers::pi * R);
+    const double A = analytic::layerCoverage(
+        analytic::ConeGeometry{p.aperture_rad, p.length_cm, p.radius_cm, p.perCone});
     if (A > 1.0) {
         where.fail("needles overlap on their cone: A = 2 N r / (pi l sin(phi)) = " +
                    formatNumber(A) + " > 1");

@@ -46,10 +46,10 @@ TEST(BakeBoughs, MassOfALongBoughMatchesTheIntegral)
     // So each error must stay under bound / 10, and the mean over sub-voxel shifts of the bough
     // must shrink with h. The axis is oblique so that no face lines up with the voxels.
     const BoughSpec b = test::paperBough(Vec3(0.3, -0.7, 0.1), Vec3(0.3, 0.5, 0.8), 60.0);
-    const double phi = b.aperture_rad, R = b.needleLength_cm * std::sin(phi), L = 60.0;
-    const double A = 2.0 * b.needlesPerCone * b.needleRadius_cm / (kPi * R);
+    const double phi = b.needles.cone.aperture_rad, R = b.needles.cone.needleLength_cm * std::sin(phi), L = 60.0;
+    const double A = 2.0 * b.needles.cone.needlesPerCone * b.needles.cone.needleRadius_cm / (kPi * R);
     const double mu = -std::log(1.0 - A);
-    const double exact = mu / (2.0 * b.coneSpacing_cm * std::sin(phi)) * kPi * R * R * L;
+    const double exact = mu / (2.0 * b.needles.coneSpacing_cm * std::sin(phi)) * kPi * R * R * L;
     const double surfaceOverVolume = 2.0 / R + 2.0 / (L * std::sin(phi));
 
     double previousMean = 0.0;
@@ -81,9 +81,9 @@ TEST(BakeBoughs, MassOfALongBoughMatchesTheIntegral)
 /// Index box around a bough's region (its cones' reach), widened by one voxel.
 openvdb::CoordBBox searchBox(const BoughSpec& b, double h)
 {
-    const double R = b.needleLength_cm * std::sin(b.aperture_rad);
+    const double R = b.needles.cone.needleLength_cm * std::sin(b.needles.cone.aperture_rad);
     const Vec3 axis = glm::normalize(b.tip_cm - b.base_cm);
-    const Vec3 end = b.tip_cm + axis * (R / std::tan(b.aperture_rad));
+    const Vec3 end = b.tip_cm + axis * (R / std::tan(b.needles.cone.aperture_rad));
     openvdb::CoordBBox box;
     for (const Vec3& p : {b.base_cm, end}) {
         for (const double dx : {-R, R}) {
@@ -152,7 +152,7 @@ TEST(BakeBoughs, OverlapKeepsTheDensestBoughWhateverTheOrder)
     // both reach, the voxel holds the denser one, whichever is listed first.
     const BoughSpec thin = test::paperBough(Vec3(-8.0, 0.0, 0.0), Vec3(1, 0, 0), 16.0);
     BoughSpec dense = test::paperBough(Vec3(0.0, -8.0, 0.3), Vec3(0, 1, 0), 16.0);
-    dense.needlesPerCone = 24;
+    dense.needles.cone.needlesPerCone = 24;
     dense.needleAlbedo = Vec3(0.5);
     const BakeSettings settings{0.3, 1};
     const TreeGrids ab = bakeBoughs({thin, dense}, settings);
@@ -220,7 +220,7 @@ TEST(BakeBoughs, RejectsWhatItCannotBake)
     EXPECT_THROW(bakeBoughs({b}, BakeSettings{std::nan(""), 1}), BakeError);
     EXPECT_THROW(bakeBoughs({b}, BakeSettings{0.5, 0}), BakeError);
     BoughSpec bad = b;
-    bad.aperture_rad = 2.0;
+    bad.needles.cone.aperture_rad = 2.0;
     EXPECT_THROW(bakeBoughs({b, bad}, BakeSettings{0.5, 1}), BakeError);
     bad = b;
     bad.tip_cm.x = INFINITY;

@@ -34,8 +34,8 @@ TEST(LayerField, MeanOverTheSphereIsHalfTheGradientNorm)
     const Vec3 axis = unit(0.3, -0.5, 0.8);
     for (const double phi : {0.2, kPi / 8, 0.7, 1.2, kPi / 2}) {
         BoughSpec b = test::paperBough(Vec3(1.0, 2.0, -3.0), axis, 30.0);
-        b.aperture_rad = phi;
-        const double R = b.needleLength_cm * std::sin(phi);
+        b.needles.cone.aperture_rad = phi;
+        const double R = b.needles.cone.needleLength_cm * std::sin(phi);
         const Vec3 x = b.base_cm + 15.0 * axis + 0.6 * R * perpendicular(axis);
         const auto s = sampleBough(b, x);
         ASSERT_TRUE(s) << "phi " << phi;
@@ -49,9 +49,9 @@ TEST(LayerField, MeanOverTheSphereIsHalfTheGradientNorm)
         const double mean = sum / kPoints;
         EXPECT_NEAR(mean / s->meanExtinction(), 1.0, 1e-4) << "phi " << phi;
         // |G| = |axis - cot(phi) radial| / dh = 1 / (dh sin(phi)).
-        EXPECT_NEAR(glm::length(s->gradient) * b.coneSpacing_cm * std::sin(phi), 1.0, 1e-12);
+        EXPECT_NEAR(glm::length(s->gradient) * b.needles.coneSpacing_cm * std::sin(phi), 1.0, 1e-12);
         const double mu = -std::log(1.0 - s->layerOpacity);
-        EXPECT_NEAR(s->meanExtinction(), mu / (2.0 * b.coneSpacing_cm * std::sin(phi)), 1e-12);
+        EXPECT_NEAR(s->meanExtinction(), mu / (2.0 * b.needles.coneSpacing_cm * std::sin(phi)), 1e-12);
     }
 }
 
@@ -63,8 +63,8 @@ int conesCrossed(const BoughSpec& b, const Vec3& origin, const Vec3& d, double t
 {
     const Vec3 axis = glm::normalize(b.tip_cm - b.base_cm);
     const double length = glm::length(b.tip_cm - b.base_cm);
-    const double R = b.needleLength_cm * std::sin(b.aperture_rad);
-    const double cot = 1.0 / std::tan(b.aperture_rad);
+    const double R = b.needles.cone.needleLength_cm * std::sin(b.needles.cone.aperture_rad);
+    const double cot = 1.0 / std::tan(b.needles.cone.aperture_rad);
     int crossings = 0;
     bool have = false;
     double previous = 0.0;
@@ -77,7 +77,7 @@ int conesCrossed(const BoughSpec& b, const Vec3& origin, const Vec3& d, double t
             have = false;
             continue;
         }
-        const double layer = std::floor(g / b.coneSpacing_cm);
+        const double layer = std::floor(g / b.needles.coneSpacing_cm);
         if (have && layer != previous) crossings += int(std::abs(layer - previous));
         previous = layer;
         have = true;
@@ -95,13 +95,13 @@ TEST(LayerField, ChordThroughTheAxisCrossesAsManyConesAsItCounts)
     const Vec3 axis = unit(0.2, 0.9, -0.4);
     const BoughSpec b = test::paperBough(Vec3(5.0, -1.0, 2.0), axis, 40.0);
     const Vec3 across = perpendicular(axis);
-    const double R = b.needleLength_cm * std::sin(b.aperture_rad);
+    const double R = b.needles.cone.needleLength_cm * std::sin(b.needles.cone.aperture_rad);
     constexpr int kOffsets = 50;
     constexpr int kSteps = 20000;
     const double dt = 2.0 * (R + 0.5) / kSteps;
     double sumDepth = 0.0, sumCount = 0.0, mu = 0.0;
     for (int m = 0; m < kOffsets; ++m) {
-        const double h0 = 20.0 + b.coneSpacing_cm * (m + 0.5) / kOffsets;
+        const double h0 = 20.0 + b.needles.coneSpacing_cm * (m + 0.5) / kOffsets;
         const Vec3 centre = b.base_cm + h0 * axis;
         // Midpoint rule: the integrand is piecewise constant, so only the two cells on the
         // region's edge are in error, by at most dt each.
@@ -121,7 +121,7 @@ TEST(LayerField, ChordThroughTheAxisCrossesAsManyConesAsItCounts)
     ASSERT_GT(mu, 0.0);
     EXPECT_NEAR(sumDepth / mu / kOffsets, sumCount / kOffsets, 2.0 / kOffsets + 1e-3);
     // And both are the exact 2 R cot(phi) / dh (4.36 per half on the paper's bough).
-    EXPECT_NEAR(sumCount / kOffsets, 2.0 * R / std::tan(b.aperture_rad) / b.coneSpacing_cm,
+    EXPECT_NEAR(sumCount / kOffsets, 2.0 * R / std::tan(b.needles.cone.aperture_rad) / b.needles.coneSpacing_cm,
                 2.0 / kOffsets);
 }
 
@@ -129,8 +129,8 @@ TEST(LayerField, NothingOutsideTheRegion)
 {
     const Vec3 axis = unit(0.0, 0.0, 1.0);
     const BoughSpec b = test::paperBough(Vec3(0.0), axis, 10.0);
-    const double R = b.needleLength_cm * std::sin(b.aperture_rad);
-    const double cot = 1.0 / std::tan(b.aperture_rad);
+    const double R = b.needles.cone.needleLength_cm * std::sin(b.needles.cone.aperture_rad);
+    const double cot = 1.0 / std::tan(b.needles.cone.aperture_rad);
     const Vec3 e(1.0, 0.0, 0.0);
     // Inside: halfway out, halfway along.
     EXPECT_TRUE(sampleBough(b, 5.0 * axis + 0.5 * R * e));
@@ -158,15 +158,15 @@ TEST(LayerField, DegenerateBoughsFillNothing)
     zeroLength.tip_cm = zeroLength.base_cm;
     EXPECT_FALSE(sampleBough(zeroLength, Vec3(0.5, 0.0, 0.5)));
     BoughSpec noNeedles = b;
-    noNeedles.needlesPerCone = 0;
+    noNeedles.needles.cone.needlesPerCone = 0;
     EXPECT_FALSE(sampleBough(noNeedles, x));
     BoughSpec badAperture = b;
-    badAperture.aperture_rad = 0.0;
+    badAperture.needles.cone.aperture_rad = 0.0;
     EXPECT_FALSE(sampleBough(badAperture, x));
-    badAperture.aperture_rad = std::nan("");
+    badAperture.needles.cone.aperture_rad = std::nan("");
     EXPECT_FALSE(sampleBough(badAperture, x));
     BoughSpec badSpacing = b;
-    badSpacing.coneSpacing_cm = 0.0;
+    badSpacing.needles.coneSpacing_cm = 0.0;
     EXPECT_FALSE(sampleBough(badSpacing, x));
 }
 
@@ -182,7 +182,7 @@ TEST(LayerField, NeedleLiesOnItsCone)
     ASSERT_TRUE(s);
     EXPECT_NEAR(glm::dot(s->needle, s->gradient), 0.0, 1e-12);
     EXPECT_NEAR(glm::length(s->needle), 1.0, 1e-12);
-    EXPECT_NEAR(glm::dot(s->needle, axis), std::cos(b.aperture_rad), 1e-12);
+    EXPECT_NEAR(glm::dot(s->needle, axis), std::cos(b.needles.cone.aperture_rad), 1e-12);
     EXPECT_GT(glm::dot(s->needle, x - (b.base_cm + 10.0 * axis)), 0.0);
     EXPECT_NEAR(s->layerOpacity, 2.0 * 12 * 0.05 / (kPi * 4.25 * std::sin(kPi / 8)), 1e-12);
 }
@@ -191,7 +191,7 @@ TEST(LayerField, OpaqueLayersStayFinite)
 {
     // A = 1 (needles covering the cone) would make mu infinite; the cap keeps it finite.
     BoughSpec b = test::paperBough(Vec3(0.0), Vec3(0, 0, 1), 10.0);
-    b.needlesPerCone = 1000;
+    b.needles.cone.needlesPerCone = 1000;
     const auto s = sampleBough(b, Vec3(0.5, 0.0, 5.0));
     ASSERT_TRUE(s);
     EXPECT_EQ(s->layerOpacity, 1.0);

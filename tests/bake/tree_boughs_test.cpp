@@ -26,11 +26,11 @@ TEST(TreeBoughs, FollowTheSegmentsAtMidBoughInTheTracersHue)
         const scenes::Segment& segment = tree.segments[bough.segment];
         EXPECT_EQ(specs[i].base_cm, segment.base_cm);
         EXPECT_EQ(specs[i].tip_cm, segment.tip_cm);
-        EXPECT_DOUBLE_EQ(specs[i].aperture_rad,
+        EXPECT_DOUBLE_EQ(specs[i].needles.cone.aperture_rad,
                          0.5 * (bough.atBase.aperture_rad + bough.atTip.aperture_rad));
-        EXPECT_DOUBLE_EQ(specs[i].needleLength_cm,
+        EXPECT_DOUBLE_EQ(specs[i].needles.cone.needleLength_cm,
                          0.5 * (bough.atBase.length_cm + bough.atTip.length_cm));
-        EXPECT_DOUBLE_EQ(specs[i].coneSpacing_cm,
+        EXPECT_DOUBLE_EQ(specs[i].needles.coneSpacing_cm,
                          0.5 * (bough.atBase.coneSpacing_cm + bough.atTip.coneSpacing_cm));
         // vdbtrace's hued(kNeedleHue, albedo): hue (0.45, 1, 0.35) scaled so green = albedo.
         EXPECT_DOUBLE_EQ(specs[i].needleAlbedo.y, species.needleAlbedo);

@@ -22,7 +22,7 @@ TreeGrids twoBoughs(double voxelSize_cm = 0.4, int levels = 3)
 {
     BoughSpec a = test::paperBough(Vec3(-8.0, 0.0, 0.0), Vec3(1, 0, 0), 16.0);
     BoughSpec b = test::paperBough(Vec3(0.0, -8.0, 2.0), Vec3(0, 1, 0.2), 14.0);
-    b.needlesPerCone = 20;
+    b.needles.cone.needlesPerCone = 20;
     b.needleAlbedo = Vec3(0.2, 0.4, 0.1);
     return bakeBoughs({a, b}, BakeSettings{voxelSize_cm, levels});
 }

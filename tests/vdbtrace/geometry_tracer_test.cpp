@@ -125,22 +125,17 @@ struct HandMade {
     TracedBough& add(const Vec3& base, const Vec3& axis, double length_cm,
                      const analytic::ConeGeometry& cone, unsigned seed)
     {
-        TracedBough b;
-        b.base_cm = base;
-        b.axis = glm::normalize(axis);
-        b.length_cm = length_cm;
-        b.tip_cm = base + length_cm * b.axis;
-        b.geometry.cone = cone;
-        b.geometry.coneSpacing_cm = 0.9;
-        b.radius_cm = analytic::boughRadius(cone);
-        b.layerOpacity = analytic::layerOpacity(cone);
-        b.conesEnd_cm = b.tip_cm + cone.needleLength_cm * std::cos(cone.aperture_rad) * b.axis;
-        b.needleAlbedo = Vec3(0.3);
-        b.specularWeight = 0.2;
-        b.exponent = 200.0;
-        b.seed = seed;
-        b.lighting.resize(traced.lights.size());
-        traced.boughs.push_back(b);
+        BoughDescription d;
+        d.spec.base_cm = base;
+        d.spec.tip_cm = base + length_cm * glm::normalize(axis);
+        d.spec.needles.cone = cone;
+        d.spec.needles.coneSpacing_cm = 0.9;
+        d.spec.needleAlbedo = Vec3(0.3);
+        d.specularWeight = 0.2;
+        d.exponent = 200.0;
+        d.seed = seed;
+        traced.boughs.push_back(
+            makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear")));
         return traced.boughs.back();
     }
 };
@@ -159,7 +154,7 @@ SideOnCoverage renderSideOnBough(const analytic::ConeGeometry& cone, unsigned se
     s.add(Vec3(-5, 0, 0), Vec3(1, 0, 0), 5.0, cone, seed);
     const TracedBough& b = s.traced.boughs.front();
     s.traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
-    RenderOptions level1;
+    MultiscaleOptions level1;
     level1.forceLevel = 1;
     GeometryOptions options;
     options.samples = 64;
@@ -250,7 +245,7 @@ TEST(GeometryTracer, MatchesTheReferenceOnAThinBoughUpToTheLayersObliquity)
     GeometryOptions options;
     options.samples = 64;
     const RenderResult geometry = renderGeometry(s.traced, options);
-    const bake::TreeGrids grids = bakeScene(s.traced, 0.1);
+    const bake::TreeGrids grids = bake::bakeBoughs(boughSpecs(s.traced), referenceBake(0.1));
     const RenderResult reference = renderReference(s.traced, grids);
     double covered[2] = {0.0, 0.0};
     for (std::size_t i = 3; i < geometry.image.rgba.size(); i += 4) {

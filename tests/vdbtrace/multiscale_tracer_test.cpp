@@ -25,7 +25,7 @@ RenderResult render(const std::string& json, int forceLevel = 0)
 {
     const scenes::Scene scene = scenes::parseScene(json, "test.json");
     const TracedScene traced = buildTracedScene(scene);
-    RenderOptions options;
+    MultiscaleOptions options;
     options.forceLevel = forceLevel;
     return renderMultiscale(traced, options);
 }
@@ -140,24 +140,14 @@ struct SideOnBough {
   "lights": [{"type": "directional", "direction": [0, -1, 0.2]}],
   "ground": {"type": "none"}, "species": {}, "trees": [], "effects": ["diffuse"]})", "side-on.json");
         traced = buildTracedScene(scene);
-        TracedBough b;
-        b.base_cm = Vec3(-40, 0, 0);
-        b.tip_cm = Vec3(40, 0, 0);
-        b.axis = Vec3(1, 0, 0);
-        b.length_cm = 80;
-        b.geometry.cone = {analytic::kPi / 8, 4.25, 0.05, 12};
-        b.geometry.coneSpacing_cm = 0.9;
-        b.radius_cm = analytic::boughRadius(b.geometry.cone);
-        b.layerOpacity = analytic::layerOpacity(b.geometry.cone);
-        b.conesEnd_cm = b.tip_cm + 4.25 * std::cos(analytic::kPi / 8) * b.axis;
-        const Vec3 V(0, -1, 0);
-        b.alpha = analytic::boughLinearLaw(b.geometry,
-                                           analytic::boughView(analytic::kPi / 8, b.axis, V, V))
-                      .alphaView;
-        BoughLighting lit;
-        lit.law = analytic::boughLinearLaw(b.geometry, analytic::boughView(analytic::kPi / 8, b.axis, V, V));
-        b.lighting.push_back(lit);
-        traced.boughs.push_back(b);
+        BoughDescription d;
+        d.spec.base_cm = Vec3(-40, 0, 0);
+        d.spec.tip_cm = Vec3(40, 0, 0);
+        d.spec.needles.cone = {analytic::kPi / 8, 4.25, 0.05, 12};
+        d.spec.needles.coneSpacing_cm = 0.9;
+        traced.boughs.push_back(
+            makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear")));
+        const TracedBough& b = traced.boughs.back();
         traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
     }
 };
@@ -171,7 +161,7 @@ TEST(MultiscaleTracer, ConeLevelCrossesTheTrueCones)
     // 1 - [(1 - f) T^floor(n) + f T^ceil(n)], T = 1 - A, f = frac(n). (Section 6.2's asymptotes
     // would give 2 sqrt(R^2 - x^2) cot(phi) / dh instead: errata E12.)
     SideOnBough s;
-    RenderOptions options;
+    MultiscaleOptions options;
     options.forceLevel = 2;
     const RenderResult r = renderMultiscale(s.traced, options);
     const TracedBough& b = s.traced.boughs.front();
@@ -202,13 +192,40 @@ TEST(MultiscaleTracer, BoughLevelCompositesSection66sHalves)
     // Level 3 inside the bough's strip: front then rear half, 1 - (1 - alpha_FV)(1 - alpha_RV),
     // the same on every row (section 6.6 averages over the chords).
     SideOnBough s;
-    RenderOptions options;
+    MultiscaleOptions options;
     options.forceLevel = 3;
     const RenderResult r = renderMultiscale(s.traced, options);
     const TracedBough& b = s.traced.boughs.front();
     const double expected = 1.0 - (1.0 - b.alpha.front) * (1.0 - b.alpha.rear);
     const float centre = r.image.pixel(r.image.width / 2, r.image.height / 2)[3];
     EXPECT_NEAR(centre, expected, 1e-6);
+}
+
+TEST(MultiscaleTracer, BranchBeyondTheGroundIsNotShaded)
+{
+    // A branch under the ground plane is hidden by it: it is neither shaded nor sent shadow
+    // rays, though the BVH offers it. The same branch above the ground is.
+    const scenes::Scene scene = scenes::parseScene(R"({"name": "buried branch",
+  "camera": {"position": [0, -60, 12], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 30,
+             "resolution": [48, 36]},
+  "lights": [{"type": "directional", "direction": [0, -1, 1]}],
+  "ground": {"type": "plane", "height": 0}, "species": {}, "trees": [],
+  "effects": ["diffuse", "shadows"]})", "buried.json");
+    for (const double z : {-1.5, 1.5}) {
+        TracedScene traced = buildTracedScene(scene);
+        traced.branches.push_back({Vec3(-20, 0, z), Vec3(20, 0, z), 1.0, Vec3(0.3)});
+        // A conservative box, as a BVH node's may be: it reaches above the ground.
+        Aabb box = cylinderBounds(Vec3(-20, 0, z), Vec3(20, 0, z), 1.0);
+        box.grow(Vec3(0, -10, 3));
+        traced.bvh = Bvh({box});
+        const RenderResult r = renderMultiscale(traced);
+        EXPECT_GT(r.stats.groundHits, 0u);
+        if (z < 0.0) {
+            EXPECT_EQ(r.stats.branchHits, 0u);
+        } else {
+            EXPECT_GT(r.stats.branchHits, 0u);
+        }
+    }
 }
 
 TEST(MultiscaleTracer, EveryShippedSceneRendersFiniteAndBounded)

@@ -31,17 +31,15 @@ struct SideOn {
   "ground": {"type": "none"}, "species": {}, "trees": [], "effects": ["diffuse"]})",
                                    "side-on.json");
         traced = buildTracedScene(scene);
-        TracedBough b;
-        b.axis = Vec3(std::cos(tilt_rad), std::sin(tilt_rad), 0);
-        b.base_cm = -20.0 * b.axis;
-        b.tip_cm = 20.0 * b.axis;
-        b.length_cm = 40;
-        b.geometry.cone = {analytic::kPi / 8, 4.25, 0.05, 12};
-        b.geometry.coneSpacing_cm = 0.9;
-        b.radius_cm = analytic::boughRadius(b.geometry.cone);
-        b.layerOpacity = analytic::layerOpacity(b.geometry.cone);
-        b.needleAlbedo = Vec3(0.3);
-        traced.boughs.push_back(b);
+        BoughDescription d;
+        const Vec3 axis(std::cos(tilt_rad), std::sin(tilt_rad), 0);
+        d.spec.base_cm = -20.0 * axis;
+        d.spec.tip_cm = 20.0 * axis;
+        d.spec.needles.cone = {analytic::kPi / 8, 4.25, 0.05, 12};
+        d.spec.needles.coneSpacing_cm = 0.9;
+        d.spec.needleAlbedo = Vec3(0.3);
+        traced.boughs.push_back(
+            makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear")));
     }
 };
 
@@ -50,7 +48,7 @@ struct SideOn {
 // its opacity is 1 - exp(-mu layers) (analytic/true_cone_bough.h).
 double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
 {
-    const bake::TreeGrids grids = bakeScene(s.traced, voxel);
+    const bake::TreeGrids grids = bake::bakeBoughs(boughSpecs(s.traced), referenceBake(voxel));
     ReferenceOptions options;
     options.subpixels = 1;
     const RenderResult r = renderReference(s.traced, grids, options);
@@ -97,7 +95,7 @@ TEST(ReferenceTracer, NoBoughsRendersTransparent)
 {
     SideOn s;
     s.traced.boughs.clear();
-    const bake::TreeGrids grids = bakeScene(s.traced, 0.5);
+    const bake::TreeGrids grids = bake::bakeBoughs(boughSpecs(s.traced), referenceBake(0.5));
     const RenderResult r = renderReference(s.traced, grids);
     for (std::size_t i = 3; i < r.image.rgba.size(); i += 4) ASSERT_EQ(r.image.rgba[i], 0.0f);
 }

@@ -1,5 +1,6 @@
 #include "pine/vdbtrace/compare.h"
 
+#include "pine/bake/tree_boughs.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/flicker.h"
 #include "pine/vdbtrace/geometry_tracer.h"
@@ -118,7 +119,7 @@ Row renderReferenceRow(const TracedScene& traced, double voxel_cm, int subpixels
 {
     Row row{"reference", num(voxel_cm) + "cm"};
     const auto start = Clock::now();
-    const bake::TreeGrids grids = bakeScene(traced, voxel_cm);
+    const bake::TreeGrids grids = bake::bakeScene(traced.trees, referenceBake(voxel_cm));
     row.prepSeconds = since(start);
     ReferenceOptions options;
     options.subpixels = subpixels;
@@ -130,7 +131,7 @@ Row renderReferenceRow(const TracedScene& traced, double voxel_cm, int subpixels
 Row renderMultiscaleRow(const TracedScene& traced, int level)
 {
     Row row{"multiscale", level ? "L" + std::to_string(level) : "auto"};
-    RenderOptions options;
+    MultiscaleOptions options;
     options.forceLevel = level;
     const auto start = Clock::now();
     row.image = renderMultiscale(traced, options).image;

@@ -10,10 +10,10 @@
 // solid cylinder.
 #include "pine/vdbtrace/geometry_tracer.h"
 
-#include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/ground_hit.h"
-#include "pine/vdbtrace/tiled_render.h"
 #include "pine/vdbtrace/needle_layout.h"
+#include "pine/vdbtrace/effects_plan.h"
+#include "pine/vdbtrace/render_driver.h"
 
 #include <embree3/rtcore.h>
 #include <glm/geometric.hpp>
@@ -34,8 +34,6 @@ namespace {
 
 constexpr double kPi = analytic::kPi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double luminance(const Vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
 // One solid cylinder: a needle or a branch. The axis is stored in float (tip error l * 6e-8),
 // the base in double so that a forest kilometres wide keeps its needles' 0.05 cm radius exact.
@@ -276,18 +274,18 @@ std::uint64_t mix(std::uint64_t z)
     return z ^ (z >> 31);
 }
 
-class SampleTracer {
+class GeometryRayTracer final : public ShadingMethod::RayTracer {
 public:
-    SampleTracer(const TracedScene& scene, const EffectsPlan& plan, const EmbreeScene& embree,
-                 const CylinderSet& branches, const CylinderSet& needles, RenderStats& stats)
+    GeometryRayTracer(const TracedScene& scene, const EffectsPlan& plan,
+                      const EmbreeScene& embree, const CylinderSet& branches,
+                      const CylinderSet& needles, RenderStats& stats)
         : mScene(scene), mPlan(plan), mEmbree(embree), mBranches(branches), mNeedles(needles),
           mStats(stats), mShadows(plan.shadowRays || plan.selfShadowing)
     {
     }
 
-    /// One point sample: adds its radiance to the sums, returns the hit's distance (inf: none)
-    /// and whether it was a needle.
-    double trace(const ConeRay& ray, Vec3& diffuse, Vec3& specular, bool& needle);
+    /// One point sample: the closest hit, shaded, as one opaque fragment (foliage if a needle).
+    void trace(const ConeRay& ray, FrontToBack& composite) override;
 
 private:
     bool occluded(const Vec3& x, const Vec3& towards, double distance, unsigned geomID,
@@ -302,7 +300,7 @@ private:
     bool mShadows;
 };
 
-bool SampleTracer::occluded(const Vec3& x, const Vec3& towards, double distance,
+bool GeometryRayTracer::occluded(const Vec3& x, const Vec3& towards, double distance,
                             unsigned geomID, unsigned primID)
 {
     ++mStats.shadowRays;
@@ -325,10 +323,8 @@ bool SampleTracer::occluded(const Vec3& x, const Vec3& towards, double distance,
     return ray.tfar < 0.0f;
 }
 
-double SampleTracer::trace(const ConeRay& ray, Vec3& diffuse, Vec3& specular, bool& needle)
+void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
 {
-    ++mStats.coneRays;
-    needle = false;
     double tGround = kInf;
     Vec3 groundNormal(0.0);
     if (!hitGround(mScene.scene->ground, ray, tGround, groundNormal)) tGround = kInf;
@@ -350,7 +346,7 @@ double SampleTracer::trace(const ConeRay& ray, Vec3& diffuse, Vec3& specular, bo
     rtcIntersect1(mEmbree.scene(), &ctx.embree, &rh);
 
     const bool cylinder = ctx.geomID != RTC_INVALID_GEOMETRY_ID;
-    if (!cylinder && !std::isfinite(tGround)) return kInf;
+    if (!cylinder && !std::isfinite(tGround)) return;
     const double t = cylinder ? ctx.t : tGround;
     const Vec3 x = ray.origin + t * ray.direction, V = -ray.direction;
 
@@ -375,7 +371,7 @@ double SampleTracer::trace(const ConeRay& ray, Vec3& diffuse, Vec3& specular, bo
     } else {
         ++mStats.groundHits;
     }
-    needle = isNeedle;
+    Fragment f{t, 1.0, Vec3(0.0), Vec3(0.0), 0, isNeedle};
     const bool shadeSpecular = mPlan.specular && isNeedle;
 
     for (const Light& light : mScene.lights) {
@@ -400,15 +396,15 @@ double SampleTracer::trace(const ConeRay& ray, Vec3& diffuse, Vec3& specular, bo
             E = Vec3(0.0);
         }
         if (mPlan.diffuse) {
-            diffuse += albedo / kPi * E * cosL;
+            f.diffuse += albedo / kPi * E * cosL;
             ++mStats.diffuseEvaluations;
         }
         if (shadeSpecular) {
-            specular += weight * E * lobe;
+            f.specular += weight * E * lobe;
             ++mStats.specularEvaluations;
         }
     }
-    return t;
+    composite.add(f);
 }
 
 // Every needle of every bough (needle_layout.h) and every branch, as cylinders; the box pad
@@ -452,94 +448,73 @@ void layOut(const TracedScene& scene, CylinderSet& branches, CylinderSet& needle
     branches.pad = needles.pad = pad;
 }
 
+// Embree's scene of every needle and branch, and the sample pattern.
+class Geometry final : public ShadingMethod {
+public:
+    Geometry(const TracedScene& scene, const GeometryOptions& options)
+        : mScene(scene), mPlan(EffectsPlan::from(scene.scene->effects)),
+          mSamples(std::max(1, options.samples)), mSampleSeed(options.sampleSeed),
+          mSampleWidth(1.0 / std::sqrt(double(mSamples)))
+    {
+        layOut(scene, mBranchSet, mNeedleSet);
+        mEmbree.attach(mBranchSet);
+        mEmbree.attach(mNeedleSet);
+        mEmbree.commit();
+    }
+
+    GeometryBuild build(double seconds) const
+    {
+        GeometryBuild b;
+        b.needles = mNeedleSet.cylinders.size();
+        b.branches = mBranchSet.cylinders.size();
+        b.seconds = seconds;
+        b.primitiveBytes = (mNeedleSet.cylinders.capacity() + mBranchSet.cylinders.capacity()) *
+                           sizeof(Cylinder);
+        b.embreePeakBytes = mEmbree.peakBytes();
+        return b;
+    }
+
+    int samplesPerPixel() const override { return mSamples; }
+    /// A sample is a point: its cone is as narrow as a sample's share of the pixel (only the
+    /// ground test reads the ray, and only its axis).
+    ConeRay sample(const ConeCamera& camera, int x, int y, int s) const override
+    {
+        const std::uint64_t key = mix((std::uint64_t(mSampleSeed) << 48) ^
+                                      (std::uint64_t(std::uint32_t(y)) << 24) ^
+                                      std::uint64_t(std::uint32_t(x)));
+        const std::uint32_t shiftX = std::uint32_t(key), shiftY = std::uint32_t(key >> 32);
+        const double u = double(sobol1(std::uint32_t(s)) ^ shiftX) * 0x1.0p-32;
+        const double v = double(sobol2(std::uint32_t(s)) ^ shiftY) * 0x1.0p-32;
+        return camera.coneAt(x + u, y + v, mSampleWidth);
+    }
+    std::unique_ptr<RayTracer> rayTracer(RenderStats& stats) const override
+    {
+        return std::make_unique<GeometryRayTracer>(mScene, mPlan, mEmbree, mBranchSet,
+                                                   mNeedleSet, stats);
+    }
+
+private:
+    const TracedScene& mScene;
+    EffectsPlan mPlan;
+    int mSamples;
+    unsigned mSampleSeed;
+    double mSampleWidth;
+    CylinderSet mBranchSet, mNeedleSet;
+    EmbreeScene mEmbree;
+};
+
 }  // namespace
 
-RenderResult renderGeometry(const TracedScene& scene, const GeometryOptions& options)
+RenderResult renderGeometry(const TracedScene& scene, const GeometryOptions& method,
+                            const RenderOptions& options)
 {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    const ConeCamera camera(scene.scene->camera);
-    const EffectsPlan plan = EffectsPlan::from(scene.scene->effects);
-    const int samples = std::max(1, options.samples);
-
-    CylinderSet branches, needles;
-    layOut(scene, branches, needles);
-    EmbreeScene embree;
-    embree.attach(branches);
-    embree.attach(needles);
-    embree.commit();
-    GeometryBuild build;
-    build.needles = needles.cylinders.size();
-    build.branches = branches.cylinders.size();
-    build.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    build.primitiveBytes = (needles.cylinders.capacity() + branches.cylinders.capacity()) *
-                           sizeof(Cylinder);
-    build.embreePeakBytes = embree.peakBytes();
-    if (options.built) options.built(build);
-
-    RenderResult result;
-    result.image = Image(camera.width(), camera.height());
-    Image& image = result.image;
-    for (const char* name : {"level", "depth", "diffuse", "specular", "foliage"}) image.aov(name);
-
-    // A sample is a point: its cone is as narrow as a sample's share of the pixel (only the
-    // ground test reads the ray, and only its axis).
-    const double sampleWidth = 1.0 / std::sqrt(double(samples));
-    forEachTile(camera.width(), camera.height(), options.tileSize, options.progress, result.stats,
-                [&](int x0, int y0, int x1, int y1, RenderStats& stats) {
-        SampleTracer tracer(scene, plan, embree, branches, needles, stats);
-        std::vector<double> depths;
-        for (int y = y0; y < y1; ++y) {
-            for (int x = x0; x < x1; ++x) {
-                const auto t0 = Clock::now();
-                const std::uint64_t key = mix((std::uint64_t(options.sampleSeed) << 48) ^
-                                              (std::uint64_t(std::uint32_t(y)) << 24) ^
-                                              std::uint64_t(std::uint32_t(x)));
-                const std::uint32_t shiftX = std::uint32_t(key), shiftY = std::uint32_t(key >> 32);
-                Vec3 diffuse(0.0), specular(0.0);
-                int hits = 0, needleHits = 0;
-                depths.clear();
-                for (int s = 0; s < samples; ++s) {
-                    const double u = double(sobol1(std::uint32_t(s)) ^ shiftX) * 0x1.0p-32;
-                    const double v = double(sobol2(std::uint32_t(s)) ^ shiftY) * 0x1.0p-32;
-                    bool needle;
-                    const double t =
-                        tracer.trace(camera.coneAt(x + u, y + v, sampleWidth), diffuse, specular,
-                                     needle);
-                    if (std::isfinite(t)) {
-                        ++hits;
-                        depths.push_back(t);
-                    }
-                    needleHits += needle;
-                }
-                const double inv = 1.0 / samples;
-                diffuse *= inv;
-                specular *= inv;
-                const Vec3 colour = diffuse + specular;
-                float* p = image.pixel(x, y);
-                p[0] = float(colour.x);
-                p[1] = float(colour.y);
-                p[2] = float(colour.z);
-                p[3] = float(hits * inv);
-                const std::size_t i = std::size_t(y) * camera.width() + x;
-                // Depth where the covered fraction passes 0.5, as the multiscale tracer's
-                // accumulated alpha does: the ceil(S/2)-th nearest hit.
-                const std::size_t half = std::size_t((samples + 1) / 2);
-                if (depths.size() >= half) {
-                    std::nth_element(depths.begin(), depths.begin() + (half - 1), depths.end());
-                    image.aovs["depth"][i] = float(depths[half - 1]);
-                }
-                image.aovs["diffuse"][i] = float(luminance(diffuse));
-                image.aovs["specular"][i] = float(luminance(specular));
-                image.aovs["foliage"][i] = float(needleHits * inv);
-                ++stats.pixelsPerLevel[0];
-                stats.nanosecondsPerLevel[0] += std::uint64_t(
-                    std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0)
-                        .count());
-            }
-        }
-    });
-    result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    const Geometry geometry(scene, method);
+    const double buildSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    if (method.built) method.built(geometry.build(buildSeconds));
+    RenderResult result = renderImage(scene, geometry, options);
+    result.seconds += buildSeconds;
     return result;
 }
 

@@ -1,32 +1,18 @@
 #include "pine/vdbtrace/traced_scene.h"
 
 #include "pine/analytic/cone_shader.h"
+#include "pine/bake/tree_boughs.h"
+#include "pine/scenes/colours.h"
 
 #include <glm/geometric.hpp>
 #include <tbb/parallel_for.h>
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace pine::vdbtrace {
 namespace {
-
-// Needle and bark colours: the species gives a scalar albedo; the hue is fixed here.
-const Vec3 kNeedleHue{0.45, 1.0, 0.35};
-const Vec3 kBarkHue{1.0, 0.75, 0.55};
-
-Vec3 hued(const Vec3& hue, double albedo) { return hue * (albedo / hue.y); }
-
-analytic::BoughGeometry boughGeometry(const scenes::NeedleParameters& p)
-{
-    analytic::BoughGeometry g;
-    g.cone.aperture_rad = p.aperture_rad;
-    g.cone.needleLength_cm = p.length_cm;
-    g.cone.needleRadius_cm = p.radius_cm;
-    g.cone.needlesPerCone = p.perCone;
-    g.coneSpacing_cm = p.coneSpacing_cm;
-    return g;
-}
 
 std::vector<Light> unifiedLights(const scenes::Scene& scene)
 {
@@ -83,8 +69,64 @@ ConeRay Light::shadowCone(const Vec3& x, double footprint_cm, double& tMax) cons
     return ray;
 }
 
-TracedScene buildTracedScene(const scenes::Scene& scene)
+TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
+                            const std::vector<Light>& lights, const BoughLaw& law)
 {
+    TracedBough b;
+    b.base_cm = d.spec.base_cm;
+    b.tip_cm = d.spec.tip_cm;
+    b.length_cm = glm::length(b.tip_cm - b.base_cm);
+    if (!(b.length_cm > 0.0)) throw std::invalid_argument("a bough of zero length");
+    b.axis = (b.tip_cm - b.base_cm) / b.length_cm;
+    b.geometry = d.spec.needles;
+    const analytic::ConeGeometry& cone = b.geometry.cone;
+    b.radius_cm = analytic::boughRadius(cone);
+    b.layerOpacity = analytic::layerOpacity(cone);
+    b.conesEnd_cm = b.tip_cm + cone.needleLength_cm * std::cos(cone.aperture_rad) * b.axis;
+    b.needleAlbedo = d.spec.needleAlbedo;
+    b.specularWeight = d.specularWeight;
+    b.exponent = d.exponent;
+    b.seed = d.seed;
+
+    // Directions from the bough's centre: to the camera (V) and to each light (L).
+    const Vec3 centre = 0.5 * (b.base_cm + b.tip_cm);
+    const Vec3 V = glm::normalize(eye_cm - centre);
+    std::vector<Vec3> towards;
+    for (const Light& light : lights) {
+        Vec3 L, irradiance;
+        double distance;
+        light.at(centre, L, distance, irradiance);
+        towards.push_back(L);
+    }
+    const BoughShading shading = law.shade(b.geometry, b.axis, V, towards);
+    b.alpha = shading.alpha;
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        const auto sums = analytic::coneSums(
+            cone, analytic::coneIntegrals(cone.aperture_rad, b.axis, towards[i], V, b.exponent),
+            b.exponent);
+        BoughLighting lit;
+        lit.front = analytic::meanReflectance(sums.front);
+        lit.rear = analytic::meanReflectance(sums.rear);
+        lit.transfer = shading.lights[i].transfer;
+        lit.opacityFromLight = shading.lights[i].opacityFromLight;
+        b.lighting.push_back(lit);
+    }
+    return b;
+}
+
+std::vector<bake::BoughSpec> boughSpecs(const TracedScene& scene)
+{
+    std::vector<bake::BoughSpec> specs;
+    specs.reserve(scene.boughs.size());
+    for (const TracedBough& b : scene.boughs) {
+        specs.push_back({b.base_cm, b.tip_cm, b.geometry, b.needleAlbedo});
+    }
+    return specs;
+}
+
+TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneOptions& options)
+{
+    const BoughLaw& law = boughLaw(options.boughLaw);
     TracedScene out;
     out.scene = &scene;
     out.lights = unifiedLights(scene);
@@ -94,63 +136,27 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
         out.trees[i] = scenes::growTree(scene.species.at(placement.species), placement);
     });
 
+    std::vector<BoughDescription> boughs;
     for (std::size_t i = 0; i < out.trees.size(); ++i) {
         const scenes::Tree& tree = out.trees[i];
         const scenes::Species& species = *tree.species;
         for (const scenes::Segment& s : tree.segments) {
-            out.branches.push_back(
-                {s.base_cm, s.tip_cm, s.radius_cm, hued(kBarkHue, species.barkAlbedo)});
+            out.branches.push_back({s.base_cm, s.tip_cm, s.radius_cm, scenes::barkColour(species)});
         }
-        for (std::size_t j = 0; j < tree.boughs.size(); ++j) {
-            const scenes::Bough& b = tree.boughs[j];
-            const scenes::Segment& s = tree.segments[b.segment];
-            TracedBough tb;
-            tb.base_cm = s.base_cm;
-            tb.tip_cm = s.tip_cm;
-            tb.length_cm = glm::length(s.tip_cm - s.base_cm);
-            if (!(tb.length_cm > 0.0)) continue;
-            tb.axis = (s.tip_cm - s.base_cm) / tb.length_cm;
-            tb.geometry = boughGeometry(scenes::lerp(b.atBase, b.atTip, 0.5));
-            tb.radius_cm = analytic::boughRadius(tb.geometry.cone);
-            tb.layerOpacity = analytic::layerOpacity(tb.geometry.cone);
-            tb.conesEnd_cm = tb.tip_cm + tb.geometry.cone.needleLength_cm *
-                                             std::cos(tb.geometry.cone.aperture_rad) * tb.axis;
-            tb.needleAlbedo = hued(kNeedleHue, species.needleAlbedo);
-            tb.specularWeight = species.needleSpecular;
-            tb.exponent = species.specularExponent;
-            tb.seed = unsigned(i * 7919u + j * 104729u + scene.trees[i].seed);
-            out.boughs.push_back(tb);
+        const std::vector<bake::BoughSpec> specs = bake::treeBoughs(tree);
+        for (std::size_t j = 0; j < specs.size(); ++j) {
+            if (!(glm::length(specs[j].tip_cm - specs[j].base_cm) > 0.0)) continue;
+            BoughDescription d;
+            d.spec = specs[j];
+            d.specularWeight = species.needleSpecular;
+            d.exponent = species.specularExponent;
+            d.seed = unsigned(i * 7919u + j * 104729u + scene.trees[i].seed);
+            boughs.push_back(d);
         }
     }
-
-    // Directions from each bough's centre: to the camera (V) and to each light (L).
-    const Vec3 eye = scene.camera.position_cm;
-    tbb::parallel_for(std::size_t(0), out.boughs.size(), [&](std::size_t k) {
-        TracedBough& b = out.boughs[k];
-        const Vec3 centre = 0.5 * (b.base_cm + b.tip_cm);
-        const Vec3 V = glm::normalize(eye - centre);
-        const double phiAperture = b.geometry.cone.aperture_rad;
-        b.alpha =
-            analytic::boughLinearLaw(b.geometry, analytic::boughView(phiAperture, b.axis, V, V))
-                .alphaView;
-        for (const Light& light : out.lights) {
-            Vec3 L, irradiance;
-            double distance;
-            light.at(centre, L, distance, irradiance);
-            BoughLighting lit;
-            const double phi = b.geometry.cone.aperture_rad;
-            const auto sums = analytic::coneSums(
-                b.geometry.cone, analytic::coneIntegrals(phi, b.axis, L, V, b.exponent),
-                b.exponent);
-            lit.front = analytic::meanReflectance(sums.front);
-            lit.rear = analytic::meanReflectance(sums.rear);
-            lit.view = analytic::boughView(phi, b.axis, L, V);
-            lit.law = analytic::boughLinearLaw(b.geometry, lit.view);
-            const auto fromLight =
-                analytic::boughLinearLaw(b.geometry, analytic::boughView(phi, b.axis, L, L));
-            lit.opacityFromLight = fromLight.alphaView.front + fromLight.alphaView.rear;
-            b.lighting.push_back(lit);
-        }
+    out.boughs.resize(boughs.size());
+    tbb::parallel_for(std::size_t(0), boughs.size(), [&](std::size_t k) {
+        out.boughs[k] = makeTracedBough(boughs[k], scene.camera.position_cm, out.lights, law);
     });
 
     std::vector<Aabb> boxes;

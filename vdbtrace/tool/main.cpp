@@ -1,4 +1,5 @@
 // vdbtrace: render a scene with the multiscale cone tracer, benchmark it, or compare methods.
+#include "pine/bake/tree_boughs.h"
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/vdbtrace/compare.h"
@@ -108,27 +109,27 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
               << describe(loaded->scene, loaded->traced) << '\n';
     vdbtrace::RenderResult result;
     if (method == "multiscale") {
-        vdbtrace::RenderOptions options = withProgress("rendering");
+        vdbtrace::MultiscaleOptions options;
         options.forceLevel = forceLevel;
-        result = vdbtrace::renderMultiscale(loaded->traced, options);
+        result = vdbtrace::renderMultiscale(loaded->traced, options, withProgress("rendering"));
     } else if (method == "geometry") {
         vdbtrace::GeometryOptions options;
         options.samples = samples;
-        options.progress = withProgress("rendering").progress;
         options.built = [](const vdbtrace::GeometryBuild& b) {
             std::cerr << "vdbtrace: " << b.needles << " needles and " << b.branches
                       << " branches as cylinders, BVH built in " << b.seconds << " s ("
                       << double(b.primitiveBytes) / (1 << 20) << " MiB of cylinders, Embree peak "
                       << double(b.embreePeakBytes) / (1 << 20) << " MiB)\n";
         };
-        result = vdbtrace::renderGeometry(loaded->traced, options);
+        result = vdbtrace::renderGeometry(loaded->traced, options, withProgress("rendering"));
     } else {
         bake::TreeGrids grids;
         if (baked) {
             grids = *baked;  // files bake wrote, checked against their manifests
         } else {
             std::cerr << "vdbtrace: baking the boughs at " << reference.voxelSize_cm << " cm\n";
-            grids = vdbtrace::bakeScene(loaded->traced, reference.voxelSize_cm);
+            grids = bake::bakeScene(loaded->traced.trees,
+                                    vdbtrace::referenceBake(reference.voxelSize_cm));
         }
         std::cerr
             << "vdbtrace: " << grids.layerOpacity->activeVoxelCount() << " voxels of "
@@ -137,8 +138,8 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
             << " s\n";
         vdbtrace::ReferenceOptions options;
         options.subpixels = reference.subpixels;
-        options.progress = withProgress("rendering").progress;
-        result = vdbtrace::renderReference(loaded->traced, grids, options);
+        result = vdbtrace::renderReference(loaded->traced, grids, options,
+                                           withProgress("rendering"));
     }
     std::cerr << '\n';
 
@@ -201,7 +202,7 @@ vdbtrace::RenderResult timed(const scenes::Scene& scene, const std::string& labe
         *buildSeconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
-    vdbtrace::RenderResult r = vdbtrace::renderMultiscale(traced, withProgress(label));
+    vdbtrace::RenderResult r = vdbtrace::renderMultiscale(traced, {}, withProgress(label));
     std::cerr << '\n';
     return r;
 }

@@ -27,8 +27,13 @@ struct ConeGeometry {
 /// R = l sin(phi): radius of the bough cylinder, in cm (section 3.1).
 double boughRadius(const ConeGeometry& cone);
 
+/// 2 N r / (pi R): the needles' projected area over the cone's, unclamped; above 1 the needles
+/// of one cone overlap and no shader level describes them (what scene files are checked
+/// against). 0 for a cone of zero radius.
+double layerCoverage(const ConeGeometry& cone);
+
 /// A = 2 N r / (pi R): the mean fraction of the cone surface the needles cover (section 3.3).
-/// Clamped to [0, 1]; 0 for a cone of zero radius.
+/// layerCoverage clamped to [0, 1].
 double layerOpacity(const ConeGeometry& cone);
 
 /// The dimensionless face integrals J, G, S of the header comment.

@@ -5,6 +5,8 @@
 // A, so its extinction is sigma(d) = -ln(1 - A) |d . G| per cm with G = grad g / dh.
 #pragma once
 
+#include "pine/analytic/bough_shader.h"
+
 #include <glm/vec3.hpp>
 
 #include <optional>
@@ -13,14 +15,11 @@ namespace pine::bake {
 
 using Vec3 = glm::dvec3;
 
-/// One bough: its branch from base to tip and the needle parameters at mid-bough.
+/// One bough: its branch from base to tip and the needle parameters at mid-bough, in the
+/// shaders' own type (section 3.1's phi, l, r, N and dh), which the tracer reads too.
 struct BoughSpec {
     Vec3 base_cm{0.0}, tip_cm{0.0, 0.0, 1.0};
-    double aperture_rad = 0.3927;  ///< phi
-    double needleLength_cm = 4.25;
-    double needleRadius_cm = 0.05;
-    double needlesPerCone = 12;
-    double coneSpacing_cm = 0.9;
+    analytic::BoughGeometry needles;
     Vec3 needleAlbedo{0.2};
 };
 

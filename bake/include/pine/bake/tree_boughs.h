@@ -2,22 +2,29 @@
 #pragma once
 
 #include "pine/bake/layer_field.h"
+#include "pine/bake/tree_grids.h"
 
 #include <vector>
 
 namespace pine::scenes {
+struct NeedleParameters;
 struct Tree;
 }
 
 namespace pine::bake {
 
-/// The needle hue of the tracer (vdbtrace/src/traced_scene.cpp, kNeedleHue): a species' grey
-/// needle albedo a becomes a hue * a / hue.y, so bakes and renders colour needles alike.
-inline constexpr double kNeedleHue[3] = {0.45, 1.0, 0.35};
+/// A scene's needle parameters (scenes::NeedleParameters) as the shaders' type: the one place
+/// where one becomes the other.
+analytic::BoughGeometry boughGeometry(const scenes::NeedleParameters& p);
 
-/// The boughs of a grown tree (scenes::growTree, with its species set): branch from the
-/// segment's base to its tip, needle parameters at mid-bough (they vary slowly along a branch,
-/// section 3.1), albedo the species' needle albedo in the tracer's hue.
+/// The boughs of a grown tree (scenes::growTree, with its species set), one per tree.boughs in
+/// order: branch from the segment's base to its tip, needle parameters at mid-bough (they vary
+/// slowly along a branch, section 3.1), albedo scenes::needleColour. The tracer prepares its
+/// boughs from the same list.
 std::vector<BoughSpec> treeBoughs(const scenes::Tree& tree);
+
+/// The boughs of all `trees` in one set of grids, the trees' boughs in order: what the
+/// reference method renders a whole scene through (bake tree/scene write one file a tree).
+TreeGrids bakeScene(const std::vector<scenes::Tree>& trees, const BakeSettings& settings);
 
 }  // namespace pine::bake

@@ -1,10 +1,8 @@
-// What the tracer computes, decided once from the scene's effects, and what it counted: a
-// switched-off effect costs nothing (DESIGN.md), and the stats prove it.
+// What the tracer computes, decided once from the scene's effects: a switched-off effect costs
+// nothing (DESIGN.md), and the stats (render_stats.h) prove it.
 #pragma once
 
 #include "pine/scenes/scene.h"
-
-#include <cstdint>
 
 namespace pine::vdbtrace {
 
@@ -18,28 +16,6 @@ struct EffectsPlan {
     {
         return {effects.diffuse, effects.specular, effects.shadows, effects.selfShadowing};
     }
-};
-
-/// Counts of the work done. Integers only, so that sums over tiles do not depend on the order
-/// in which threads finish.
-struct RenderStats {
-    std::uint64_t coneRays = 0;         ///< one per pixel
-    std::uint64_t shadowRays = 0;       ///< cone shadow rays traced through the scene
-    /// Light attenuated by a bough's own layers: a counted march at levels 1-2, section 6.6's
-    /// brackets at level 3.
-    std::uint64_t selfShadowEvaluations = 0;
-    std::uint64_t needleHits = 0;       ///< level 1: explicit needles covering a footprint
-    std::uint64_t coneHits = 0;         ///< level 2: cone surfaces crossed
-    std::uint64_t boughHits = 0;        ///< level 3: boughs shaded as volumes
-    std::uint64_t branchHits = 0;
-    std::uint64_t groundHits = 0;
-    std::uint64_t voxelSpans = 0;       ///< reference method: voxel spans integrated
-    std::uint64_t diffuseEvaluations = 0;
-    std::uint64_t specularEvaluations = 0;
-    std::uint64_t pixelsPerLevel[4] = {0, 0, 0, 0};  ///< by the level covering most: 0 = none
-    std::uint64_t nanosecondsPerLevel[4] = {0, 0, 0, 0};  ///< time of those pixels
-
-    RenderStats& operator+=(const RenderStats& o);
 };
 
 }  // namespace pine::vdbtrace

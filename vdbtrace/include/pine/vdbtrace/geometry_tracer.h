@@ -6,7 +6,7 @@
 // projected area, so the multiscale and reference tracers can be measured against it.
 #pragma once
 
-#include "pine/vdbtrace/multiscale_tracer.h"
+#include "pine/vdbtrace/render_result.h"
 #include "pine/vdbtrace/traced_scene.h"
 
 #include <cstddef>
@@ -26,12 +26,9 @@ struct GeometryOptions {
     /// Point samples per pixel, on a digitally shifted (0,2)-sequence (Sobol' dimensions 1-2):
     /// every power of two of them is stratified in every elementary interval of the pixel.
     int samples = 16;
-    int tileSize = 16;
     /// Selects another shift of the sequence: an independent render with the same error
     /// statistics (tests compare against one).
     unsigned sampleSeed = 0;
-    /// Called from worker threads with the fraction done, at most every 2%.
-    std::function<void(double)> progress;
     /// Called once the BVH is built, before the first ray.
     std::function<void(const GeometryBuild&)> built;
 };
@@ -49,6 +46,7 @@ struct GeometryOptions {
 /// either scene effect turns shadow rays on. The ground casts no shadow, as in the other
 /// methods.
 /// @throw std::runtime_error if Embree fails (device, memory).
-RenderResult renderGeometry(const TracedScene& scene, const GeometryOptions& options = {});
+RenderResult renderGeometry(const TracedScene& scene, const GeometryOptions& method = {},
+                            const RenderOptions& options = {});
 
 }  // namespace pine::vdbtrace

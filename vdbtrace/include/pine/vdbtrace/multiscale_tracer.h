@@ -3,11 +3,8 @@
 // front to back.
 #pragma once
 
-#include "pine/vdbtrace/effects_plan.h"
-#include "pine/vdbtrace/image.h"
+#include "pine/vdbtrace/render_result.h"
 #include "pine/vdbtrace/traced_scene.h"
-
-#include <functional>
 
 namespace pine::vdbtrace {
 
@@ -15,20 +12,15 @@ namespace pine::vdbtrace {
 enum class Level { Needle = 1, Cone = 2, Bough = 3 };
 Level chooseLevel(double footprint_cm, double coneSpacing_cm, const scenes::RenderSettings& s);
 
-struct RenderOptions {
-    int tileSize = 16;
-    /// Called from worker threads with the fraction done, at most every 2%.
-    std::function<void(double)> progress;
+struct MultiscaleOptions {
     /// Forces every bough hit to this level (0: choose by footprint) - for comparisons.
     int forceLevel = 0;
 };
 
-struct RenderResult {
-    Image image;  ///< RGBA plus AOVs "level", "depth", "diffuse", "specular", "foliage"
-    RenderStats stats;
-    double seconds = 0.0;
-};
-
-RenderResult renderMultiscale(const TracedScene& scene, const RenderOptions& options = {});
+/// Renders with the closed forms: needles (level 1) as anti-aliased cylinders, cones (level 2)
+/// by eqs. (4)-(6) at each crossing of the true cones, boughs (level 3) as section 6's volume
+/// under the scene's bough law (TracedSceneOptions), lit through cone shadow rays.
+RenderResult renderMultiscale(const TracedScene& scene, const MultiscaleOptions& method = {},
+                              const RenderOptions& options = {});
 
 }  // namespace pine::vdbtrace

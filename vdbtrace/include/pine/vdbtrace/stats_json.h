@@ -2,6 +2,7 @@
 #pragma once
 
 #include "pine/vdbtrace/effects_plan.h"
+#include "pine/vdbtrace/render_stats.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,7 +1,7 @@
 // The loop every tracer shares: tiles rendered in parallel, their stats summed, progress told.
 #pragma once
 
-#include "pine/vdbtrace/effects_plan.h"
+#include "pine/vdbtrace/render_stats.h"
 
 #include <tbb/parallel_for.h>
 

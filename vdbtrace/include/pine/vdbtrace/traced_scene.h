@@ -5,11 +5,15 @@
 #pragma once
 
 #include "pine/analytic/bough_shader.h"
+#include "pine/analytic/cone_shader.h"
+#include "pine/bake/layer_field.h"
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
+#include "pine/vdbtrace/bough_law.h"
 #include "pine/vdbtrace/bvh.h"
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -37,9 +41,16 @@ struct TracedBranch {
 /// What a bough looks like from one light with the camera where it is (section 6 inputs).
 struct BoughLighting {
     analytic::FaceReflectance front, rear;  ///< I^cyl of each face (diffuse, specular)
-    analytic::BoughView view;               ///< layer rates for this view and light
-    analytic::BoughLinearLaw law;           ///< section 6.6 under the linear law, clamped
-    double opacityFromLight = 0.0;          ///< the whole bough's opacity seen from the light
+    analytic::FrontRear transfer;           ///< the bough law's, with self-shadowing
+    double opacityFromLight = 0.0;          ///< the bough law's: the whole bough from the light
+};
+
+/// What the scene says of one bough: what makeTracedBough prepares.
+struct BoughDescription {
+    bake::BoughSpec spec;  ///< branch, needle parameters, albedo: what bake voxelizes too
+    double specularWeight = 0.0;
+    double exponent = 100.0;
+    unsigned seed = 0;  ///< drives the needles' azimuths (needle_layout.h)
 };
 
 struct TracedBough {
@@ -55,10 +66,17 @@ struct TracedBough {
     Vec3 needleAlbedo{0.2};
     double specularWeight = 0.0;
     double exponent = 100.0;
-    analytic::FrontRear alpha;            ///< opacity of each half seen from the camera (6.6)
-    unsigned seed = 0;                    ///< drives the needles' azimuths at level 1
+    analytic::FrontRear alpha;  ///< the bough law's opacity of each half seen from the camera
+    unsigned seed = 0;          ///< drives the needles' azimuths at level 1
     std::vector<BoughLighting> lighting;  ///< one per light
 };
+
+/// The bough of `description` prepared for a camera at `eye_cm` and `lights` under `law`: its
+/// frame, R and A, and everything that depends only on directions from its centre (the cone
+/// level's face reflectances, the law's opacities and transfers), once per bough and light.
+/// @throw std::invalid_argument for a bough of zero length.
+TracedBough makeTracedBough(const BoughDescription& description, const Vec3& eye_cm,
+                            const std::vector<Light>& lights, const BoughLaw& law);
 
 struct TracedScene {
     const scenes::Scene* scene = nullptr;
@@ -75,8 +93,17 @@ struct TracedScene {
     }
 };
 
+/// The boughs of `scene` as bake voxelizes them: what the reference's grids are baked from,
+/// for a scene grown from trees (the same as bake::bakeScene of its trees) or made by hand.
+std::vector<bake::BoughSpec> boughSpecs(const TracedScene& scene);
+
+/// The choices of model that preparing a scene makes.
+struct TracedSceneOptions {
+    std::string boughLaw = "linear";  ///< a name of boughLawNames()
+};
+
 /// Grows every tree and prepares the scene for its camera, in parallel. Keeps a pointer to
-/// `scene`, which must outlive the result.
-TracedScene buildTracedScene(const scenes::Scene& scene);
+/// `scene`, which must outlive the result. Throws std::invalid_argument for an unknown law.
+TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneOptions& options = {});
 
 }  // namespace pine::vdbtrace

@@ -1,0 +1,66 @@
+// What a camera ray meets: fragments (partial coverages of its footprint, each with its
+// radiance), composited front to back with Porter & Duff's "over". Every method hands its
+// hits to the same compositor, so that the pixel means the same thing whichever shaded it.
+#pragma once
+
+#include "pine/vdbtrace/geometry.h"
+
+#include <limits>
+
+namespace pine::vdbtrace {
+
+/// Linear luminance (Rec. 709 primaries) of linear RGB: the AOVs' and the errors' measure.
+inline double luminance(const Vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+struct Fragment {
+    double t = 0.0;                    ///< distance along the ray, cm: where it sorts
+    double alpha = 0.0;                ///< fraction of the footprint covered, in [0, 1]
+    Vec3 diffuse{0.0}, specular{0.0};  ///< radiance, premultiplied by alpha
+    int level = 0;                     ///< 1-3: the multiscale level that shaded it; 0: none
+    bool foliage = false;              ///< needles, at any scale: the "foliage" AOV
+};
+
+/// One camera ray's fragments composited, front to back.
+struct SampleValue {
+    Vec3 diffuse{0.0}, specular{0.0};  ///< premultiplied
+    double alpha = 0.0;                ///< accumulated coverage, at most 1
+    double foliage = 0.0;              ///< the part of alpha that foliage fragments gave
+    double levelWeight[4] = {0.0, 0.0, 0.0, 0.0};  ///< the part each level gave (0: none)
+    double levelSum = 0.0;             ///< sum over fragments of their part times level
+    /// Where the accumulated coverage passes 1/2 (the fragment's t), infinite if it never does.
+    double depth = std::numeric_limits<double>::infinity();
+};
+
+class FrontToBack {
+public:
+    /// Accumulated coverage beyond which nothing behind can show.
+    static constexpr double kOpaque = 0.999;
+
+    /// Adds `f` behind everything added so far. A method stops adding once opaque(): the
+    /// multiscale method before each fragment, the reference before each voxel span.
+    void add(const Fragment& f)
+    {
+        const double weight = (1.0 - mValue.alpha) * f.alpha;
+        mValue.diffuse += (1.0 - mValue.alpha) * f.diffuse;
+        mValue.specular += (1.0 - mValue.alpha) * f.specular;
+        if (f.foliage) mValue.foliage += weight;
+        if (f.level > 0) {
+            mValue.levelSum += weight * f.level;
+            mValue.levelWeight[f.level] += weight;
+        }
+        if (mValue.alpha < 0.5 && mValue.alpha + weight >= 0.5) mValue.depth = f.t;
+        mValue.alpha += weight;
+    }
+    bool opaque() const { return mValue.alpha > kOpaque; }
+    SampleValue value() const
+    {
+        SampleValue v = mValue;
+        v.alpha = std::min(1.0, v.alpha);
+        return v;
+    }
+
+private:
+    SampleValue mValue;
+};
+
+}  // namespace pine::vdbtrace

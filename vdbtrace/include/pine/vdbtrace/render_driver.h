@@ -1,0 +1,42 @@
+// The render loop every method shares (pbrt-v4's ImageTileIntegrator: one loop, one hook).
+// The driver owns the camera, the tiles, the samples of each pixel, compositing, the AOVs,
+// progress, timing and stats; a method supplies only what a camera ray meets (its fragments).
+#pragma once
+
+#include "pine/vdbtrace/cone_camera.h"
+#include "pine/vdbtrace/fragment.h"
+#include "pine/vdbtrace/render_result.h"
+#include "pine/vdbtrace/traced_scene.h"
+
+#include <memory>
+
+namespace pine::vdbtrace {
+
+/// One way to shade what a camera ray meets: multiscale, reference or geometry.
+class ShadingMethod {
+public:
+    /// Per-thread state of a method: it traces one camera ray at a time.
+    class RayTracer {
+    public:
+        virtual ~RayTracer() = default;
+        /// Adds what `ray` meets to `composite`, in front-to-back order, counting into the
+        /// stats it was made with.
+        virtual void trace(const ConeRay& ray, FrontToBack& composite) = 0;
+    };
+
+    virtual ~ShadingMethod() = default;
+    /// Camera rays per pixel; their values are averaged.
+    virtual int samplesPerPixel() const = 0;
+    /// Camera ray `s` of pixel (x, y), s in [0, samplesPerPixel()).
+    virtual ConeRay sample(const ConeCamera& camera, int x, int y, int s) const = 0;
+    virtual std::unique_ptr<RayTracer> rayTracer(RenderStats& stats) const = 0;
+};
+
+/// Renders the scene's camera with `method`: every pixel the mean of its samples' composites
+/// (RGBA, diffuse, specular, foliage), its level the coverage-weighted mean level, its depth the
+/// ceil(S/2)-th nearest of its S samples' depths (where the pixel's coverage passes 1/2). The
+/// same image whatever the thread count. `result.seconds` is the loop's time alone.
+RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
+                         const RenderOptions& options);
+
+}  // namespace pine::vdbtrace

@@ -1,0 +1,131 @@
+#include "pine/vdbtrace/render_driver.h"
+
+#include "pine/vdbtrace/tiled_render.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+namespace pine::vdbtrace {
+namespace {
+
+// The AOV planes of kAovNames, looked up once per render, not per pixel.
+struct Aovs {
+    explicit Aovs(Image& image)
+        : level(image.aov("level").data()), depth(image.aov("depth").data()),
+          diffuse(image.aov("diffuse").data()), specular(image.aov("specular").data()),
+          foliage(image.aov("foliage").data())
+    {
+    }
+    float *level, *depth, *diffuse, *specular, *foliage;
+};
+
+// A pixel's samples, summed, then written as its RGBA and AOVs.
+class PixelSum {
+public:
+    void add(const SampleValue& v)
+    {
+        mDiffuse += v.diffuse;
+        mSpecular += v.specular;
+        mAlpha += v.alpha;
+        mFoliage += v.foliage;
+        mLevelSum += v.levelSum;
+        for (int k = 0; k < 4; ++k) mLevelWeight[k] += v.levelWeight[k];
+        if (std::isfinite(v.depth)) mDepths.push_back(v.depth);
+        ++mSamples;
+    }
+
+    void write(Image& image, const Aovs& aovs, int x, int y)
+    {
+        const double w = 1.0 / mSamples;
+        const Vec3 colour = (mDiffuse + mSpecular) * w;
+        float* p = image.pixel(x, y);
+        p[0] = float(colour.x);
+        p[1] = float(colour.y);
+        p[2] = float(colour.z);
+        p[3] = float(mAlpha * w);
+        const std::size_t i = std::size_t(y) * std::size_t(image.width) + std::size_t(x);
+        aovs.level[i] = mFoliage > 0.0 ? float(mLevelSum / mFoliage) : 0.0f;
+        aovs.diffuse[i] = float(luminance(mDiffuse * w));
+        aovs.specular[i] = float(luminance(mSpecular * w));
+        aovs.foliage[i] = float(mFoliage * w);
+        // The pixel's coverage passes 1/2 at the ceil(S/2)-th nearest sample depth.
+        const std::size_t half = std::size_t((mSamples + 1) / 2);
+        if (mDepths.size() >= half) {
+            std::nth_element(mDepths.begin(), mDepths.begin() + std::ptrdiff_t(half - 1),
+                             mDepths.end());
+            aovs.depth[i] = float(mDepths[half - 1]);
+        }
+    }
+
+    /// The level that covered most of the pixel (0: none covered more than 1e-6).
+    int dominantLevel() const
+    {
+        int dominant = 0;
+        for (int k = 1; k <= 3; ++k) {
+            if (mLevelWeight[k] > 1e-6 && mLevelWeight[k] > mLevelWeight[dominant]) dominant = k;
+        }
+        return dominant;
+    }
+
+    void clear()
+    {
+        mDiffuse = mSpecular = Vec3(0.0);
+        mAlpha = mFoliage = mLevelSum = 0.0;
+        for (double& w : mLevelWeight) w = 0.0;
+        mDepths.clear();  // keeps its capacity: no allocation per pixel
+        mSamples = 0;
+    }
+
+private:
+    Vec3 mDiffuse{0.0}, mSpecular{0.0};
+    double mAlpha = 0.0, mFoliage = 0.0, mLevelSum = 0.0;
+    double mLevelWeight[4] = {0.0, 0.0, 0.0, 0.0};
+    std::vector<double> mDepths;
+    int mSamples = 0;
+};
+
+}  // namespace
+
+RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
+                         const RenderOptions& options)
+{
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    const ConeCamera camera(scene.scene->camera);
+    RenderResult result;
+    result.image = Image(camera.width(), camera.height());
+    Image& image = result.image;
+    for (const char* name : kAovNames) image.aov(name);
+    const Aovs aovs(image);
+    const int samples = std::max(1, method.samplesPerPixel());
+
+    forEachTile(camera.width(), camera.height(), options.tileSize, options.progress, result.stats,
+                [&](int x0, int y0, int x1, int y1, RenderStats& stats) {
+        const std::unique_ptr<ShadingMethod::RayTracer> tracer = method.rayTracer(stats);
+        PixelSum pixel;
+        for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; ++x) {
+                const auto t0 = Clock::now();
+                pixel.clear();
+                for (int s = 0; s < samples; ++s) {
+                    ++stats.coneRays;
+                    FrontToBack composite;
+                    tracer->trace(method.sample(camera, x, y, s), composite);
+                    pixel.add(composite.value());
+                }
+                pixel.write(image, aovs, x, y);
+                const int dominant = pixel.dominantLevel();
+                ++stats.pixelsPerLevel[dominant];
+                stats.nanosecondsPerLevel[dominant] += std::uint64_t(
+                    std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0)
+                        .count());
+            }
+        }
+    });
+    result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return result;
+}
+
+}  // namespace pine::vdbtrace
