@@ -3,6 +3,7 @@
 #include "pine/bake/tree_grids.h"
 
 #include "density_pyramid.h"
+#include "pine/bake/extinction_law.h"
 #include "prepared_bough.h"
 
 #include <openvdb/tools/Composite.h>
@@ -84,8 +85,8 @@ Interval columnInside(const PreparedBough& b, double x, double y, Interval bound
 }
 
 /// Writes the keys of one bough's voxels, keeping larger keys already there.
-void voxelizeBough(const PreparedBough& b, std::size_t index, double h,
-                   openvdb::Int64Grid::Accessor& keys)
+void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLaw& law,
+                   double h, openvdb::Int64Grid::Accessor& keys)
 {
     if (b.empty()) return;
     const Vec3 p0 = b.base(), p1 = b.base() + b.extent_cm() * b.axis();
@@ -108,7 +109,7 @@ void voxelizeBough(const PreparedBough& b, std::size_t index, double h,
                 const openvdb::Coord ijk(i, j, k);
                 const auto s = b.sample(voxelCentre(ijk, h));
                 if (!s) continue;
-                const double mean = s->meanExtinction();
+                const double mean = law.meanExtinction(*s);
                 if (!(mean > 0.0)) continue;
                 const std::int64_t key = voxelKey(mean, index);
                 if (key > keys.getValue(ijk)) keys.setValue(ijk, key);
@@ -117,7 +118,8 @@ void voxelizeBough(const PreparedBough& b, std::size_t index, double h,
     }
 }
 
-openvdb::Int64Grid::Ptr voxelKeys(const std::vector<PreparedBough>& boughs, double h)
+openvdb::Int64Grid::Ptr voxelKeys(const std::vector<PreparedBough>& boughs,
+                                  const ExtinctionLaw& law, double h)
 {
     tbb::enumerable_thread_specific<openvdb::Int64Grid::Ptr> partial(
         [] { return openvdb::Int64Grid::create(0); });
@@ -125,7 +127,7 @@ openvdb::Int64Grid::Ptr voxelKeys(const std::vector<PreparedBough>& boughs, doub
                       [&](const tbb::blocked_range<std::size_t>& range) {
                           auto keys = partial.local()->getAccessor();
                           for (std::size_t b = range.begin(); b != range.end(); ++b) {
-                              voxelizeBough(boughs[b], b, h, keys);
+                              voxelizeBough(boughs[b], b, law, h, keys);
                           }
                       });
     openvdb::Int64Grid::Ptr merged = openvdb::Int64Grid::create(0);
@@ -133,11 +135,18 @@ openvdb::Int64Grid::Ptr voxelKeys(const std::vector<PreparedBough>& boughs, doub
     return merged;
 }
 
-template <class GridT>
-typename GridT::Ptr makeGrid(const char* name, const openvdb::math::Transform::Ptr& xform)
+/// An empty grid of `info`'s type, named and described as kFields says.
+openvdb::GridBase::Ptr makeGrid(const FieldInfo& info, const openvdb::math::Transform::Ptr& xform)
 {
-    auto grid = GridT::create(typename GridT::ValueType(0));
-    grid->setName(name);
+    openvdb::GridBase::Ptr grid;
+    if (info.vector) {
+        grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+        grid->setVectorType(info.vectorType);
+        grid->setIsInWorldSpace(true);
+    } else {
+        grid = openvdb::FloatGrid::create(0.0f);
+    }
+    grid->setName(info.name);
     grid->setTransform(xform);
     return grid;
 }
@@ -165,26 +174,15 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
         }
     }
 
-    const openvdb::Int64Grid::Ptr keys = voxelKeys(prepared, h);
+    const ExtinctionLaw& law = extinctionLaw(settings.extinctionLaw);
+    const openvdb::Int64Grid::Ptr keys = voxelKeys(prepared, law, h);
 
     TreeGrids out;
     out.voxelSize_cm = h;
+    out.extinctionLaw = settings.extinctionLaw;
     const auto xform = openvdb::math::Transform::createLinearTransform(h);
-    out.density = makeGrid<openvdb::FloatGrid>(grid_names::kDensity, xform);
-    out.layerGradient = makeGrid<openvdb::Vec3SGrid>(grid_names::kLayerGradient, xform);
-    out.layerOpacity = makeGrid<openvdb::FloatGrid>(grid_names::kLayerOpacity, xform);
-    out.needleDirection = makeGrid<openvdb::Vec3SGrid>(grid_names::kNeedleDirection, xform);
-    out.needleAlbedo = makeGrid<openvdb::Vec3SGrid>(grid_names::kNeedleAlbedo, xform);
+    for (const FieldInfo& info : kFields) out.setGrid(info.field, makeGrid(info, xform));
     out.density->setGridClass(openvdb::GRID_FOG_VOLUME);
-    // How a tool must transform the vectors with the grid: G = grad g / dh is a gradient
-    // (covariant: by the inverse transpose), the needle a direction (contravariant), the
-    // albedo a colour (invariant). All are in world space.
-    out.layerGradient->setVectorType(openvdb::VEC_COVARIANT);
-    out.needleDirection->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
-    out.needleAlbedo->setVectorType(openvdb::VEC_INVARIANT);
-    for (const auto& grid : {out.layerGradient, out.needleDirection, out.needleAlbedo}) {
-        grid->setIsInWorldSpace(true);
-    }
 
     // Each kept voxel, filled from its bough at the voxel's centre.
     auto density = out.density->getAccessor();
@@ -201,7 +199,7 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
         const auto vec = [](const Vec3& v) {
             return openvdb::Vec3s(float(v.x), float(v.y), float(v.z));
         };
-        const double mean = s->meanExtinction();
+        const double mean = law.meanExtinction(*s);
         maxMean = std::max(maxMean, mean);
         density.setValue(ijk, float(mean));
         gradient.setValue(ijk, vec(s->gradient));
@@ -225,7 +223,7 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
     openvdb::FloatGrid::Ptr previous = out.density;
     for (int level = 1; level < settings.pyramidLevels; ++level) {
         openvdb::FloatGrid::Ptr coarse = detail::halveResolution(*previous);
-        coarse->setName(std::string(grid_names::kDensity) + "_lod" + std::to_string(level));
+        coarse->setName(densityLodName(level));
         coarse->setGridClass(openvdb::GRID_FOG_VOLUME);
         openvdb::tools::prune(coarse->tree());
         out.densityPyramid.push_back(coarse);

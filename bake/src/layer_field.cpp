@@ -18,18 +18,6 @@ double LayerSample::layerExtinction() const
     return std::min(-std::log1p(-std::clamp(layerOpacity, 0.0, 1.0)), kMaxLayerExtinction);
 }
 
-double LayerSample::extinction(const Vec3& d) const
-{
-    return layerExtinction() * std::abs(glm::dot(d, gradient));
-}
-
-double LayerSample::meanExtinction() const
-{
-    // The mean of |d . G| over the unit sphere is |G| / 2: with u = cos(d, G) uniform on
-    // [-1, 1], E|u| = 1/2.
-    return layerExtinction() * glm::length(gradient) * 0.5;
-}
-
 std::optional<LayerSample> sampleBough(const BoughSpec& bough, const Vec3& x_cm)
 {
     return detail::PreparedBough(bough).sample(x_cm);

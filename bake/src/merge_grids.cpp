@@ -5,15 +5,27 @@
 namespace pine::bake {
 namespace {
 
-// Copies into `into` the active voxels of `from` where `into` has none yet.
+// Copies into `into` the active voxels of `from` where `occupied` has none.
 template <class GridT>
-void fillInactive(GridT& into, const GridT& from, const openvdb::FloatGrid& occupied)
+void fillInactiveTyped(GridT& into, const GridT& from, const openvdb::FloatGrid& occupied)
 {
     auto out = into.getAccessor();
     auto taken = occupied.getConstAccessor();
     for (auto it = from.cbeginValueOn(); it; ++it) {
         if (!it.isVoxelValue()) continue;  // baked grids hold voxels, not tiles
         if (!taken.isValueOn(it.getCoord())) out.setValue(it.getCoord(), *it);
+    }
+}
+
+void fillInactive(const FieldInfo& info, const TreeGrids& into, const TreeGrids& from,
+                  const openvdb::FloatGrid& occupied)
+{
+    if (info.vector) {
+        fillInactiveTyped(static_cast<openvdb::Vec3SGrid&>(*into.grid(info.field)),
+                          static_cast<const openvdb::Vec3SGrid&>(*from.grid(info.field)), occupied);
+    } else {
+        fillInactiveTyped(static_cast<openvdb::FloatGrid&>(*into.grid(info.field)),
+                          static_cast<const openvdb::FloatGrid&>(*from.grid(info.field)), occupied);
     }
 }
 
@@ -25,11 +37,10 @@ TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
     TreeGrids out;
     const TreeGrids& first = trees.front();
     out.voxelSize_cm = first.voxelSize_cm;
-    out.density = first.density->deepCopy();
-    out.layerGradient = first.layerGradient->deepCopy();
-    out.layerOpacity = first.layerOpacity->deepCopy();
-    out.needleDirection = first.needleDirection->deepCopy();
-    out.needleAlbedo = first.needleAlbedo->deepCopy();
+    out.extinctionLaw = first.extinctionLaw;
+    for (const FieldInfo& info : kFields) {
+        out.setGrid(info.field, first.grid(info.field)->deepCopyGrid());
+    }
     out.densityScale_per_cm = first.densityScale_per_cm;
     for (std::size_t i = 1; i < trees.size(); ++i) {
         const TreeGrids& t = trees[i];
@@ -38,13 +49,13 @@ TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
                             std::to_string(out.voxelSize_cm) + " and " +
                             std::to_string(t.voxelSize_cm) + " cm");
         }
+        if (t.extinctionLaw != out.extinctionLaw) {
+            throw BakeError("bake: cannot merge grids of extinction laws '" + out.extinctionLaw +
+                            "' and '" + t.extinctionLaw + "'");
+        }
         // What the trees before this one occupy, fixed while the fields are filled.
         const openvdb::FloatGrid::Ptr occupied = out.layerOpacity->deepCopy();
-        fillInactive(*out.layerGradient, *t.layerGradient, *occupied);
-        fillInactive(*out.needleDirection, *t.needleDirection, *occupied);
-        fillInactive(*out.needleAlbedo, *t.needleAlbedo, *occupied);
-        fillInactive(*out.density, *t.density, *occupied);
-        fillInactive(*out.layerOpacity, *t.layerOpacity, *occupied);
+        for (const FieldInfo& info : kFields) fillInactive(info, out, t, *occupied);
         out.densityScale_per_cm = std::max(out.densityScale_per_cm, t.densityScale_per_cm);
     }
     return out;

@@ -3,6 +3,7 @@
 #include "pine/bake/tree_grids.h"
 
 #include "manifest.h"
+#include "pine/bake/extinction_law.h"
 
 #include <openvdb/io/Stream.h>
 
@@ -22,15 +23,17 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kDensityScaleKey = "pine:density_scale_per_cm";
-constexpr const char* kExtinction =
-    "sigma(d) = -ln(1 - layer_opacity) |d . layer_gradient| per cm; "
-    "density = mean extinction / pine:density_scale_per_cm";
+constexpr const char* kFormatVersionKey = "pine:format_version";
+constexpr const char* kExtinctionLawKey = "pine:extinction_law";
 
 openvdb::MetaMap fileMetadata(const TreeGrids& grids, const BakeProvenance& provenance)
 {
     openvdb::MetaMap meta;
+    meta.insertMeta(kFormatVersionKey, openvdb::Int32Metadata(kFormatVersion));
     meta.insertMeta("pine:units", openvdb::StringMetadata("cm"));
-    meta.insertMeta("pine:extinction", openvdb::StringMetadata(kExtinction));
+    meta.insertMeta(kExtinctionLawKey, openvdb::StringMetadata(grids.extinctionLaw));
+    meta.insertMeta("pine:extinction",
+                    openvdb::StringMetadata(extinctionLaw(grids.extinctionLaw).formula()));
     meta.insertMeta("pine:voxel_size_cm", openvdb::DoubleMetadata(grids.voxelSize_cm));
     meta.insertMeta("pine:scene", openvdb::StringMetadata(provenance.scene));
     meta.insertMeta("pine:tree", openvdb::Int32Metadata(provenance.tree));
@@ -53,19 +56,37 @@ openvdb::GridBase::Ptr densityForWriting(const openvdb::FloatGrid& grid, double 
     return copy;
 }
 
-template <class GridT>
-typename GridT::Ptr findGrid(const openvdb::GridPtrVec& grids, const std::string& name,
-                             const fs::path& path, bool required)
+openvdb::GridBase::Ptr findGrid(const openvdb::GridPtrVec& grids, const std::string& name)
 {
     for (const auto& grid : grids) {
-        if (grid && grid->getName() == name) {
-            if (auto typed = openvdb::gridPtrCast<GridT>(grid)) return typed;
-            throw BakeError("'" + path.string() + "': grid '" + name + "' has type " +
-                            grid->type() + ", expected " + GridT::gridType());
-        }
+        if (grid && grid->getName() == name) return grid;
     }
-    if (required) throw BakeError("'" + path.string() + "': no grid '" + name + "'");
     return nullptr;
+}
+
+/// Checks what the file says of itself against what this build reads.
+void checkFileMetadata(const openvdb::MetaMap* meta, const fs::path& path)
+{
+    const auto refuse = [&](const std::string& why) {
+        return BakeError("'" + path.string() + "': " + why);
+    };
+    const auto version = meta ? meta->getMetadata<openvdb::Int32Metadata>(kFormatVersionKey)
+                              : nullptr;
+    if (!version) {
+        throw refuse("no " + std::string(kFormatVersionKey) + " (baked before format " +
+                     std::to_string(kFormatVersion) + "?): bake it again");
+    }
+    if (version->value() != kFormatVersion) {
+        throw refuse("format version " + std::to_string(version->value()) + ", this build reads " +
+                     std::to_string(kFormatVersion) + ": bake it again");
+    }
+    const auto law = meta->getMetadata<openvdb::StringMetadata>(kExtinctionLawKey);
+    if (!law) throw refuse("no " + std::string(kExtinctionLawKey));
+    try {
+        extinctionLaw(law->value());
+    } catch (const BakeError& e) {
+        throw refuse(e.what());
+    }
 }
 
 }  // namespace
@@ -96,9 +117,11 @@ void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
                     const BakeProvenance& provenance)
 {
     openvdb::initialize();
-    if (!grids.density || !grids.layerGradient || !grids.layerOpacity || !grids.needleDirection ||
-        !grids.needleAlbedo) {
-        throw BakeError("cannot write '" + path.string() + "': a grid is missing");
+    for (const FieldInfo& info : kFields) {
+        if (!grids.grid(info.field)) {
+            throw BakeError("cannot write '" + path.string() + "': grid '" + info.name +
+                            "' is missing");
+        }
     }
     for (const auto& lod : grids.densityPyramid) {
         if (!lod) throw BakeError("cannot write '" + path.string() + "': a pyramid level is null");
@@ -106,10 +129,13 @@ void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
     checkWritable(path);
 
     const openvdb::MetaMap meta = fileMetadata(grids, provenance);
-    // Density first: tools that take the first grid (vdb_render) find it.
-    openvdb::GridCPtrVec list = {
-        densityForWriting(*grids.density, grids.densityScale_per_cm, meta),
-        grids.layerGradient, grids.layerOpacity, grids.needleDirection, grids.needleAlbedo};
+    // In kFields' order, density first: tools that take the first grid (vdb_render) find it.
+    openvdb::GridCPtrVec list;
+    for (const FieldInfo& info : kFields) {
+        list.push_back(info.field == Field::Density
+                           ? densityForWriting(*grids.density, grids.densityScale_per_cm, meta)
+                           : grids.grid(info.field));
+    }
     for (const auto& lod : grids.densityPyramid) {
         list.push_back(densityForWriting(*lod, grids.densityScale_per_cm, meta));
     }
@@ -149,10 +175,12 @@ TreeGrids readTreeGrids(const fs::path& path)
     const std::string bytes = detail::readVerified(path);
 
     openvdb::GridPtrVecPtr grids;
+    openvdb::MetaMap::Ptr meta;
     try {
         std::istringstream in(bytes, std::ios::binary);
         openvdb::io::Stream stream(in, /*delayLoad=*/false);
         grids = stream.getGrids();
+        meta = stream.getMetadata();
     } catch (const openvdb::Exception& e) {
         throw BakeError("cannot read '" + path.string() + "': " + e.what());
     } catch (const std::exception& e) {
@@ -160,18 +188,21 @@ TreeGrids readTreeGrids(const fs::path& path)
     }
     if (!grids) throw BakeError("cannot read '" + path.string() + "': no grids");
 
+    checkFileMetadata(meta.get(), path);
+
     TreeGrids out;
-    out.density = findGrid<openvdb::FloatGrid>(*grids, grid_names::kDensity, path, true);
-    out.layerGradient =
-        findGrid<openvdb::Vec3SGrid>(*grids, grid_names::kLayerGradient, path, true);
-    out.layerOpacity = findGrid<openvdb::FloatGrid>(*grids, grid_names::kLayerOpacity, path, true);
-    out.needleDirection =
-        findGrid<openvdb::Vec3SGrid>(*grids, grid_names::kNeedleDirection, path, true);
-    out.needleAlbedo = findGrid<openvdb::Vec3SGrid>(*grids, grid_names::kNeedleAlbedo, path, true);
+    out.extinctionLaw = meta->metaValue<std::string>(kExtinctionLawKey);
+    for (const FieldInfo& info : kFields) {
+        const openvdb::GridBase::Ptr grid = findGrid(*grids, info.name);
+        if (!grid) throw BakeError("'" + path.string() + "': no grid '" + info.name + "'");
+        try {
+            out.setGrid(info.field, grid);
+        } catch (const BakeError& e) {
+            throw BakeError("'" + path.string() + "': " + e.what());
+        }
+    }
     for (int level = 1;; ++level) {
-        const std::string name =
-            std::string(grid_names::kDensity) + "_lod" + std::to_string(level);
-        auto lod = findGrid<openvdb::FloatGrid>(*grids, name, path, false);
+        auto lod = openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(*grids, densityLodName(level)));
         if (!lod) break;
         out.densityPyramid.push_back(lod);
     }

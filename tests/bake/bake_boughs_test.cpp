@@ -1,5 +1,6 @@
 // Voxelized boughs against the continuous field: mass, values at voxel centres, the overlap
 // rule, the density pyramid.
+#include "pine/bake/extinction_law.h"
 #include "pine/bake/tree_grids.h"
 
 #include "test_support.h"
@@ -11,6 +12,8 @@
 
 namespace pine::bake {
 namespace {
+
+const ExtinctionLaw& layerLaw() { return extinctionLaw("layer"); }
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -132,8 +135,8 @@ TEST(BakeBoughs, EveryVoxelSamplesTheFieldAtItsCentre)
         if (!s) continue;
         ++inside;
         // One bough: its density is uniform, so every voxel holds the maximum, 1.
-        EXPECT_NEAR(density.getValue(ijk) * g.densityScale_per_cm, s->meanExtinction(),
-                    1e-6 * s->meanExtinction());
+        EXPECT_NEAR(density.getValue(ijk) * g.densityScale_per_cm, layerLaw().meanExtinction(*s),
+                    1e-6 * layerLaw().meanExtinction(*s));
         const auto near = [](const openvdb::Vec3s& a, const Vec3& e) {
             return std::abs(a.x() - e.x) < 1e-6 && std::abs(a.y() - e.y) < 1e-6 &&
                    std::abs(a.z() - e.z) < 1e-6;

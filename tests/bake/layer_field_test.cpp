@@ -1,5 +1,6 @@
 // The layer field against what it stands for: cones counted one by one along a ray, and the
 // mean over directions by quadrature on the sphere.
+#include "pine/bake/extinction_law.h"
 #include "pine/bake/layer_field.h"
 
 #include "test_support.h"
@@ -12,6 +13,8 @@
 
 namespace pine::bake {
 namespace {
+
+const ExtinctionLaw& layerLaw() { return extinctionLaw("layer"); }
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -44,14 +47,14 @@ TEST(LayerField, MeanOverTheSphereIsHalfTheGradientNorm)
             const double z = 1.0 - (2.0 * i + 1.0) / kPoints;
             const double r = std::sqrt(1.0 - z * z);
             const Vec3 d(r * std::cos(golden * i), r * std::sin(golden * i), z);
-            sum += s->extinction(d);
+            sum += layerLaw().extinction(*s, d);
         }
         const double mean = sum / kPoints;
-        EXPECT_NEAR(mean / s->meanExtinction(), 1.0, 1e-4) << "phi " << phi;
+        EXPECT_NEAR(mean / layerLaw().meanExtinction(*s), 1.0, 1e-4) << "phi " << phi;
         // |G| = |axis - cot(phi) radial| / dh = 1 / (dh sin(phi)).
         EXPECT_NEAR(glm::length(s->gradient) * b.needles.coneSpacing_cm * std::sin(phi), 1.0, 1e-12);
         const double mu = -std::log(1.0 - s->layerOpacity);
-        EXPECT_NEAR(s->meanExtinction(), mu / (2.0 * b.needles.coneSpacing_cm * std::sin(phi)), 1e-12);
+        EXPECT_NEAR(layerLaw().meanExtinction(*s), mu / (2.0 * b.needles.coneSpacing_cm * std::sin(phi)), 1e-12);
     }
 }
 
@@ -109,7 +112,7 @@ TEST(LayerField, ChordThroughTheAxisCrossesAsManyConesAsItCounts)
         for (int i = 0; i < kSteps; ++i) {
             const double t = -(R + 0.5) + (i + 0.5) * dt;
             if (const auto s = sampleBough(b, centre + t * across)) {
-                depth += s->extinction(across) * dt;
+                depth += layerLaw().extinction(*s, across) * dt;
                 mu = s->layerExtinction();
             }
         }
@@ -196,8 +199,8 @@ TEST(LayerField, OpaqueLayersStayFinite)
     ASSERT_TRUE(s);
     EXPECT_EQ(s->layerOpacity, 1.0);
     EXPECT_EQ(s->layerExtinction(), kMaxLayerExtinction);
-    EXPECT_TRUE(std::isfinite(s->meanExtinction()));
-    EXPECT_TRUE(std::isfinite(s->extinction(glm::normalize(s->needle))));
+    EXPECT_TRUE(std::isfinite(layerLaw().meanExtinction(*s)));
+    EXPECT_TRUE(std::isfinite(layerLaw().extinction(*s, glm::normalize(s->needle))));
 }
 
 }  // namespace

@@ -129,6 +129,8 @@ TEST(TreeGridsIo, OpenVdbSeesAFogVolumeFirstWithItsProvenance)
 
     ASSERT_TRUE(meta);
     EXPECT_EQ(meta->metaValue<std::string>("pine:units"), "cm");
+    EXPECT_EQ(meta->metaValue<openvdb::Int32>("pine:format_version"), kFormatVersion);
+    EXPECT_EQ(meta->metaValue<std::string>("pine:extinction_law"), "layer");
     EXPECT_NE(meta->metaValue<std::string>("pine:extinction").find("-ln(1 - layer_opacity)"),
               std::string::npos);
     EXPECT_EQ(meta->metaValue<double>("pine:voxel_size_cm"), 0.4);
@@ -256,13 +258,9 @@ TEST(TreeGridsIo, AMissingOrForeignManifestIsRefused)
     EXPECT_NO_THROW(readTreeGrids(dir.path() / "renamed.vdb"));
 }
 
-TEST(TreeGridsIo, WhatOpenVdbCannotReadIsABakeError)
+// A manifest beside `file` that matches its bytes, as a file edited elsewhere would have.
+void writeMatchingManifest(const fs::path& file)
 {
-    // A manifest that matches a file that is not a VDB: OpenVDB refuses it, and we say so as
-    // BakeError rather than letting its exception through.
-    const test::TempDir dir;
-    const fs::path file = dir.path() / "fake.vdb";
-    writeFile(file, "this is not a vdb file, though its manifest says it is fine\n");
     const std::string text = readFile(file);
     std::uint64_t hash = 14695981039346656037ull;
     for (const char c : text) {
@@ -272,10 +270,56 @@ TEST(TreeGridsIo, WhatOpenVdbCannotReadIsABakeError)
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
     std::ostringstream manifest;
-    manifest << R"({"file": "fake.vdb", "bytes": )" << text.size() << R"(, "fnv1a64": ")" << hex
-             << "\"}";
+    manifest << R"({"file": ")" << file.filename().string() << R"(", "bytes": )" << text.size()
+             << R"(, "fnv1a64": ")" << hex << "\"}";
     writeFile(file.string() + ".json", manifest.str());
+}
+
+TEST(TreeGridsIo, WhatOpenVdbCannotReadIsABakeError)
+{
+    // A manifest that matches a file that is not a VDB: OpenVDB refuses it, and we say so as
+    // BakeError rather than letting its exception through.
+    const test::TempDir dir;
+    const fs::path file = dir.path() / "fake.vdb";
+    writeFile(file, "this is not a vdb file, though its manifest says it is fine\n");
+    writeMatchingManifest(file);
     expectRefused(file, "cannot read");
+}
+
+TEST(TreeGridsIo, AnotherFormatVersionOrAnUnknownLawIsRefused)
+{
+    // The same grids written again by OpenVDB with one piece of file metadata changed, and a
+    // manifest that matches: what the file says of itself decides.
+    const test::TempDir dir;
+    const fs::path file = written(dir);
+    openvdb::GridPtrVecPtr grids;
+    openvdb::MetaMap::Ptr meta;
+    {
+        openvdb::io::File in(file.string());
+        in.open();
+        grids = in.getGrids();
+        meta = in.getMetadata();
+    }
+    const auto rewrite = [&](const openvdb::MetaMap& m) {
+        openvdb::io::File out(file.string());
+        out.write(*grids, m);
+        out.close();
+        writeMatchingManifest(file);
+    };
+    openvdb::MetaMap old = *meta;
+    old.removeMeta("pine:format_version");
+    rewrite(old);
+    expectRefused(file, "no pine:format_version");
+    openvdb::MetaMap future = *meta;
+    future.insertMeta("pine:format_version", openvdb::Int32Metadata(kFormatVersion + 1));
+    rewrite(future);
+    expectRefused(file, "format version " + std::to_string(kFormatVersion + 1));
+    openvdb::MetaMap unknown = *meta;
+    unknown.insertMeta("pine:extinction_law", openvdb::StringMetadata("fibre"));
+    rewrite(unknown);
+    expectRefused(file, "unknown extinction law 'fibre'");
+    rewrite(*meta);
+    EXPECT_EQ(readTreeGrids(file).extinctionLaw, "layer");
 }
 
 TEST(TreeGridsIo, UnwritableOutputIsABakeErrorAndLeavesNothing)

@@ -1,6 +1,7 @@
 #include "pine/vdbtrace/reference_tracer.h"
 
 #include "pine/analytic/needle_shader.h"
+#include "pine/bake/extinction_law.h"
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/render_driver.h"
 #include "pine/vdbtrace/surface_shading.h"
@@ -58,24 +59,28 @@ void walkVoxels(const Vec3& o, const Vec3& d, double h, double t0, double t1, Vi
     }
 }
 
-// The grids as one thread reads them.
+// The grids as one thread reads them, through the extinction law they were baked with.
 struct FieldReader {
+    const bake::ExtinctionLaw& law;
     openvdb::Vec3SGrid::ConstAccessor gradient, needle, albedo;
     openvdb::FloatGrid::ConstAccessor opacity;
     explicit FieldReader(const bake::TreeGrids& g)
-        : gradient(g.layerGradient->getConstAccessor()),
+        : law(bake::extinctionLaw(g.extinctionLaw)),
+          gradient(g.layerGradient->getConstAccessor()),
           needle(g.needleDirection->getConstAccessor()),
           albedo(g.needleAlbedo->getConstAccessor()),
           opacity(g.layerOpacity->getConstAccessor())
     {
     }
-    /// -ln(1 - A) |d . G| at voxel ijk, per cm; 0 outside the boughs.
+    /// sigma(d) at voxel ijk, per cm; 0 outside the boughs.
     double extinction(const openvdb::Coord& ijk, const Vec3& d)
     {
         float A;
         if (!opacity.probeValue(ijk, A) || !(A > 0.0f)) return 0.0;
-        const double mu = A >= 1.0f ? 1e30 : -std::log1p(-double(A));
-        return mu * std::abs(glm::dot(d, toGlm(gradient.getValue(ijk))));
+        bake::LayerSample field;
+        field.layerOpacity = A;
+        field.gradient = toGlm(gradient.getValue(ijk));
+        return law.extinction(field, d);
     }
 };
 

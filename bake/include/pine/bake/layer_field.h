@@ -2,7 +2,8 @@
 // the reference renderer integrates. Cone j is the surface g = h - rho cot(phi) = j dh, with h
 // along the branch from its base and rho the distance from it: a ray along unit d crosses
 // |d . grad g| / dh layers per cm (the true cones, no asymptotes; errata E12), each of opacity
-// A, so its extinction is sigma(d) = -ln(1 - A) |d . G| per cm with G = grad g / dh.
+// A: under the layer law (extinction_law.h) sigma(d) = -ln(1 - A) |d . G| per cm with
+// G = grad g / dh.
 #pragma once
 
 #include "pine/analytic/bough_shader.h"
@@ -28,7 +29,8 @@ struct BoughSpec {
 /// below A = 1 - 1e-6 the cap changes nothing. (added)
 inline constexpr double kMaxLayerExtinction = 13.815510557964274;
 
-/// The field at a point inside a bough's layered region.
+/// The field at a point inside a bough's layered region: what a voxel holds. How it stops
+/// light is an extinction law's (extinction_law.h).
 struct LayerSample {
     Vec3 gradient{0.0};         ///< G = (axis - cot(phi) radial) / dh, layers per cm
     Vec3 needle{0.0};           ///< unit needle direction there: cos(phi) axis + sin(phi) radial
@@ -36,10 +38,6 @@ struct LayerSample {
     /// mu = -ln(1 - A): extinction per layer crossed (docs/errata.md, E10), capped at
     /// kMaxLayerExtinction so that A = 1 stays finite. (added)
     double layerExtinction() const;
-    /// sigma(d) = -ln(1 - A) |d . G|, per cm, for a unit direction d.
-    double extinction(const Vec3& d) const;
-    /// The mean of sigma over all directions: -ln(1 - A) |G| / 2, per cm (isotropic density).
-    double meanExtinction() const;
 };
 
 /// The field at x, or nothing outside the region the bough's cones fill: rho <= R = l sin(phi)

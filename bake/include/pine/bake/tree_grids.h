@@ -19,18 +19,49 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-/// Grid names, as written (density first, so tools that take the first grid find it).
-namespace grid_names {
-inline constexpr const char* kDensity = "density";                 ///< float, fog volume, in [0, 1]
-inline constexpr const char* kLayerGradient = "layer_gradient";    ///< vec3s G, layers per cm
-inline constexpr const char* kLayerOpacity = "layer_opacity";      ///< float A
-inline constexpr const char* kNeedleDirection = "needle_direction";  ///< vec3s, unit
-inline constexpr const char* kNeedleAlbedo = "needle_albedo";      ///< vec3s, linear RGB
-}  // namespace grid_names
+/// The fields a bake writes, in the file's order: density first, so that tools that take the
+/// first grid (vdb_render) find it.
+enum class Field { Density, LayerGradient, LayerOpacity, NeedleDirection, NeedleAlbedo };
+
+struct FieldInfo {
+    Field field;
+    const char* name;             ///< the grid's name in the file
+    bool vector;                  ///< a Vec3SGrid (in world space), else a FloatGrid
+    /// How a tool must transform the vectors with the grid: G = grad g / dh is a gradient
+    /// (covariant: by the inverse transpose), the needle a direction (contravariant), the
+    /// albedo a colour (invariant).
+    openvdb::VecType vectorType;
+    const char* meaning;
+};
+
+/// The table bake, write, read and merge loop over.
+inline constexpr FieldInfo kFields[] = {
+    {Field::Density, "density", false, openvdb::VEC_INVARIANT,
+     "mean extinction / pine:density_scale_per_cm, in [0, 1] (fog volume)"},
+    {Field::LayerGradient, "layer_gradient", true, openvdb::VEC_COVARIANT,
+     "G = grad g / dh, layers crossed per cm along each axis"},
+    {Field::LayerOpacity, "layer_opacity", false, openvdb::VEC_INVARIANT,
+     "A = 2 N r / (pi R), the opacity of one layer"},
+    {Field::NeedleDirection, "needle_direction", true, openvdb::VEC_CONTRAVARIANT_RELATIVE,
+     "unit needle direction, cos(phi) axis + sin(phi) radial"},
+    {Field::NeedleAlbedo, "needle_albedo", true, openvdb::VEC_INVARIANT,
+     "needle albedo, linear RGB"},
+};
+
+/// The name of density pyramid level `level` >= 1 ("density_lod1", ...).
+inline std::string densityLodName(int level)
+{
+    return std::string(kFields[0].name) + "_lod" + std::to_string(level);
+}
+
+/// The layout of what writeTreeGrids writes (pine:format_version); readTreeGrids refuses
+/// another. 2: the first with a version and an extinction law by name.
+inline constexpr int kFormatVersion = 2;
 
 struct BakeSettings {
     double voxelSize_cm = 0.5;
     int pyramidLevels = 3;  ///< density at voxel sizes h, 2h, 4h, ...: "density_lod1", ...
+    std::string extinctionLaw = "layer";  ///< a name of extinctionLawNames()
 };
 
 /// A tree's grids in world space (cm), all on one transform of voxel size h, voxels sampled at
@@ -47,6 +78,12 @@ struct TreeGrids {
     std::vector<openvdb::FloatGrid::Ptr> densityPyramid;
     double densityScale_per_cm = 0.0;  ///< extinction per cm of density 1
     double voxelSize_cm = 0.5;
+    std::string extinctionLaw = "layer";  ///< the law density was made with, and sigma's
+
+    /// The grid of a field of kFields, untyped (null if not set).
+    openvdb::GridBase::Ptr grid(Field field) const;
+    /// Sets the grid of a field; throws BakeError unless it has the field's type.
+    void setGrid(Field field, const openvdb::GridBase::Ptr& grid);
 };
 
 /// Voxelizes the boughs (not the branches: the tracers draw those as cylinders). Boughs are
@@ -69,14 +106,16 @@ struct BakeProvenance {
 void checkWritable(const std::filesystem::path& file);
 
 /// Writes the grids atomically (temporary file in the same folder, then rename) with file
-/// metadata (units, extinction convention, voxel size, scene, tree, seed, tool version) and a
-/// manifest `PATH.json` beside it recording the file's size and checksum. Throws BakeError.
+/// metadata (format version, units, extinction law and its formula, voxel size, scene, tree,
+/// seed, tool version) and a manifest `PATH.json` beside it recording the file's size and
+/// checksum. Throws BakeError.
 void writeTreeGrids(const TreeGrids& grids, const std::filesystem::path& path,
                     const BakeProvenance& provenance);
 
 /// Reads grids written by writeTreeGrids, after checking the manifest's size and checksum:
-/// a damaged or foreign file is refused with BakeError, never opened by OpenVDB. Also catches
-/// what OpenVDB throws.
+/// a damaged or foreign file is refused with BakeError, never opened by OpenVDB. Refuses a file
+/// of another format version or of an extinction law not registered here. Also catches what
+/// OpenVDB throws.
 TreeGrids readTreeGrids(const std::filesystem::path& path);
 
 }  // namespace pine::bake

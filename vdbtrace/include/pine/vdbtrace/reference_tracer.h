@@ -26,7 +26,7 @@ inline bake::BakeSettings referenceBake(double voxelSize_cm)
     bake::BakeSettings settings;
     settings.voxelSize_cm = voxelSize_cm;
     settings.pyramidLevels = 1;
-    return settings;
+    return settings;  // the default extinction law
 }
 
 /// Renders `scene` (branches and ground as in the multiscale method, boughs through `grids`).

@@ -1,0 +1,46 @@
+#include "pine/bake/tree_grids.h"
+
+namespace pine::bake {
+namespace {
+
+template <class GridT>
+void setTyped(typename GridT::Ptr& member, const openvdb::GridBase::Ptr& grid, Field field)
+{
+    if (!grid) {
+        member = nullptr;
+        return;
+    }
+    member = openvdb::gridPtrCast<GridT>(grid);
+    if (!member) {
+        throw BakeError("grid '" + grid->getName() + "' has type " + grid->type() + ", expected " +
+                        GridT::gridType() + " for field " + kFields[int(field)].name);
+    }
+}
+
+}  // namespace
+
+openvdb::GridBase::Ptr TreeGrids::grid(Field field) const
+{
+    switch (field) {
+    case Field::Density: return density;
+    case Field::LayerGradient: return layerGradient;
+    case Field::LayerOpacity: return layerOpacity;
+    case Field::NeedleDirection: return needleDirection;
+    case Field::NeedleAlbedo: return needleAlbedo;
+    }
+    return nullptr;
+}
+
+void TreeGrids::setGrid(Field field, const openvdb::GridBase::Ptr& grid)
+{
+    switch (field) {
+    case Field::Density: return setTyped<openvdb::FloatGrid>(density, grid, field);
+    case Field::LayerGradient: return setTyped<openvdb::Vec3SGrid>(layerGradient, grid, field);
+    case Field::LayerOpacity: return setTyped<openvdb::FloatGrid>(layerOpacity, grid, field);
+    case Field::NeedleDirection:
+        return setTyped<openvdb::Vec3SGrid>(needleDirection, grid, field);
+    case Field::NeedleAlbedo: return setTyped<openvdb::Vec3SGrid>(needleAlbedo, grid, field);
+    }
+}
+
+}  // namespace pine::bake
