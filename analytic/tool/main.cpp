@@ -2,7 +2,7 @@
 #include "eval_case.h"
 #include "sweep.h"
 
-#include <CLI/CLI.hpp>
+#include "pine/support/tool_main.h"
 
 #include <iostream>
 
@@ -25,18 +25,8 @@ int main(int argc, char** argv)
     sweepCmd->add_option("--seed", sweep.seed, "Seed of the random cases");
     sweepCmd->add_flag("!--no-plot", sweep.plot, "Skip the plot (CSV and JSON only)");
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        if (e.get_exit_code() == 0) return app.exit(e);  // --help
-        std::cerr << "analytic: " << e.what() << " (see --help)\n";  // one line
-        return 2;
-    }
-    try {
+    return pine::tool::run("analytic", app, argc, argv, [&] {
         if (*eval) return pine::analytic::tool::runEval(std::cin, std::cout, std::cerr);
         return pine::analytic::tool::runSweep(sweep);
-    } catch (const std::exception& e) {
-        std::cerr << "analytic: " << e.what() << '\n';
-        return 1;
-    }
+    });
 }

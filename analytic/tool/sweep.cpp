@@ -1,5 +1,7 @@
 #include "sweep.h"
 
+#include "pine/support/atomic_file.h"
+
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/cone_shader.h"
 #include "pine/analytic/needle_shader.h"
@@ -29,20 +31,6 @@ namespace fs = std::filesystem;
 
 constexpr double kDeg = kPi / 180.0;
 
-// Writes `text` to `path` through a temporary file in the same folder, then renames it: a
-// reader never sees a half-written file, and a failed run leaves the old one intact.
-void writeAtomically(const fs::path& path, const std::string& text)
-{
-    const fs::path tmp = path.string() + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        out.close();
-        if (!out) throw std::runtime_error("cannot write " + tmp.string());
-    }
-    fs::rename(tmp, path);
-}
-
 double relativeError(double value, double reference)
 {
     return std::abs(value - reference) / std::max(std::abs(reference), 1e-300);
@@ -61,7 +49,7 @@ nlohmann::json sweepFFit(const fs::path& dir)
         if (e > worst) worst = e, at = da;
         csv << da << ',' << g << ',' << F << ',' << e << '\n';
     }
-    writeAtomically(dir / "f_fit.csv", csv.str());
+    io::writeTextAtomically(dir / "f_fit.csv", csv.str());
     return {{"max_abs_error", worst}, {"at_delta_alpha", at}, {"relative_to_peak", worst / kPi}};
 }
 
@@ -123,7 +111,7 @@ nlohmann::json sweepConeFits(const fs::path& dir, const SweepOptions& opt)
         errS.push_back(std::abs(c.ours.front.S - c.ref.front.S) / sScale);
         errSPrinted.push_back(std::abs(c.printedS - c.ref.front.S) / sScale);
     }
-    writeAtomically(dir / "cone_fits.csv", csv.str());
+    io::writeTextAtomically(dir / "cone_fits.csv", csv.str());
     const auto stats = [](std::vector<double> e) {
         std::sort(e.begin(), e.end());
         return nlohmann::json{{"median", e[e.size() / 2]},
@@ -199,7 +187,7 @@ nlohmann::json sweepLinearLaw(const fs::path& dir)
                 << relativeError(p.radianceLinear, p.radianceExact) << '\n';
         }
     }
-    writeAtomically(dir / "linear_law.csv", csv.str());
+    io::writeTextAtomically(dir / "linear_law.csv", csv.str());
 
     // Opacity alone, view orthogonal to the branch, for several layer opacities A.
     opacityCsv << "A,nA,alpha_linear_unclamped,alpha_linear,alpha_exact,rel_error_unclamped\n";
@@ -230,7 +218,7 @@ nlohmann::json sweepLinearLaw(const fs::path& dir)
                               {"nA_max_within_5pct", within5},
                               {"nA_max_within_20pct", within20}});
     }
-    writeAtomically(dir / "linear_law_opacity.csv", opacityCsv.str());
+    io::writeTextAtomically(dir / "linear_law_opacity.csv", opacityCsv.str());
 
     const LawPoint paper = lawPoint(paperBough(), axis, L, side, 0.0);
     return {{"opacity_thresholds_view_orthogonal", thresholds},
@@ -273,7 +261,7 @@ int runSweep(const SweepOptions& opt)
     summary["cone_fits"] = sweepConeFits(opt.outDir, opt);
     std::cerr << "analytic sweep: linear law against exact transmittance\n";
     summary["linear_law"] = sweepLinearLaw(opt.outDir);
-    writeAtomically(opt.outDir / "summary.json", summary.dump(2) + "\n");
+    io::writeTextAtomically(opt.outDir / "summary.json", summary.dump(2) + "\n");
 
     int status = 0;
     if (opt.plot) {

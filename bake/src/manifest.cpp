@@ -1,12 +1,13 @@
 #include "manifest.h"
 
+#include "pine/support/atomic_file.h"
+
 #include "pine/bake/tree_grids.h"
 
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <fstream>
-#include <random>
 #include <sstream>
 
 namespace pine::bake::detail {
@@ -48,34 +49,15 @@ FileDigest digestFile(const fs::path& file)
 
 fs::path manifestPath(const fs::path& file) { return fs::path(file.string() + ".json"); }
 
-fs::path temporaryBeside(const fs::path& file)
-{
-    static thread_local std::mt19937_64 rng{std::random_device{}()};
-    const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
-    return folder / ("." + file.filename().string() + ".tmp-" + Fnv1a64::hex(rng()));
-}
-
 void writeManifest(const fs::path& file, const FileDigest& digest)
 {
     const nlohmann::json j = {{"file", file.filename().string()},
                               {"bytes", digest.bytes},
                               {"fnv1a64", Fnv1a64::hex(digest.fnv1a64)}};
-    const fs::path target = manifestPath(file);
-    const fs::path tmp = temporaryBeside(target);
-    std::error_code error;
-    {
-        std::ofstream out(tmp);
-        out << j.dump(2) << '\n';
-        out.close();
-        if (!out) {
-            fs::remove(tmp, error);
-            throw BakeError("cannot write '" + target.string() + "'");
-        }
-    }
-    fs::rename(tmp, target, error);
-    if (error) {
-        fs::remove(tmp, error);
-        throw BakeError("cannot write '" + target.string() + "': " + error.message());
+    try {
+        io::writeTextAtomically(manifestPath(file), j.dump(2) + "\n");
+    } catch (const InputError& e) {
+        throw BakeError(e.what());
     }
 }
 

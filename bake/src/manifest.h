@@ -38,7 +38,4 @@ void writeManifest(const std::filesystem::path& file, const FileDigest& digest);
 /// Throws BakeError "'FILE' does not match its manifest (written by bake?): WHY".
 std::string readVerified(const std::filesystem::path& file);
 
-/// A name for a temporary file beside `file`, in the same folder so that rename is atomic.
-std::filesystem::path temporaryBeside(const std::filesystem::path& file);
-
 }  // namespace pine::bake::detail

@@ -4,6 +4,7 @@
 
 #include "manifest.h"
 #include "pine/bake/extinction_law.h"
+#include "pine/support/atomic_file.h"
 
 #include <openvdb/io/Stream.h>
 
@@ -56,6 +57,19 @@ openvdb::GridBase::Ptr densityForWriting(const openvdb::FloatGrid& grid, double 
     return copy;
 }
 
+/// Calls f, turning the shared I/O layer's InputError into this component's BakeError.
+template <class F>
+void asBakeError(F&& f)
+{
+    try {
+        f();
+    } catch (const BakeError&) {
+        throw;
+    } catch (const InputError& e) {
+        throw BakeError(e.what());
+    }
+}
+
 openvdb::GridBase::Ptr findGrid(const openvdb::GridPtrVec& grids, const std::string& name)
 {
     for (const auto& grid : grids) {
@@ -91,28 +105,6 @@ void checkFileMetadata(const openvdb::MetaMap* meta, const fs::path& path)
 
 }  // namespace
 
-void checkWritable(const fs::path& file)
-{
-    const auto refuse = [&](const std::string& why) {
-        return BakeError("cannot write '" + file.string() + "': " + why);
-    };
-    if (file.empty() || !file.has_filename()) throw refuse("no file name");
-    std::error_code error;
-    if (fs::is_directory(file, error)) throw refuse("it is a folder");
-    const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
-    if (!fs::is_directory(folder, error)) {
-        throw refuse("folder '" + folder.string() + "' is missing");
-    }
-    // Permission bits do not tell the whole story (read-only mounts, ACLs, root): try it.
-    const fs::path probe = detail::temporaryBeside(file);
-    std::FILE* f = std::fopen(probe.c_str(), "wx");
-    if (!f) {
-        throw refuse("folder '" + folder.string() + "' is not writable: " + std::strerror(errno));
-    }
-    std::fclose(f);
-    fs::remove(probe, error);
-}
-
 void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
                     const BakeProvenance& provenance)
 {
@@ -126,7 +118,7 @@ void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
     for (const auto& lod : grids.densityPyramid) {
         if (!lod) throw BakeError("cannot write '" + path.string() + "': a pyramid level is null");
     }
-    checkWritable(path);
+    asBakeError([&] { io::checkWritable(path); });
 
     const openvdb::MetaMap meta = fileMetadata(grids, provenance);
     // In kFields' order, density first: tools that take the first grid (vdb_render) find it.
@@ -142,29 +134,15 @@ void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
 
     // Written under a temporary name beside the target, then renamed: a crash or an error never
     // leaves a half-written file under the final name (DESIGN.md).
-    const fs::path tmp = detail::temporaryBeside(path);
-    std::error_code error;
-    try {
-        openvdb::io::File file(tmp.string());
-        file.write(list, meta);
-        file.close();
-    } catch (const std::exception& e) {  // openvdb::Exception derives from std::exception
-        fs::remove(tmp, error);
-        throw BakeError("cannot write '" + path.string() + "': " + e.what());
-    }
     detail::FileDigest digest;
-    try {
-        digest = detail::digestFile(tmp);
-    } catch (...) {
-        fs::remove(tmp, error);
-        throw;
-    }
-    fs::rename(tmp, path, error);
-    if (error) {
-        const std::string why = error.message();
-        fs::remove(tmp, error);
-        throw BakeError("cannot write '" + path.string() + "': " + why);
-    }
+    asBakeError([&] {
+        io::writeAtomically(path, [&](const fs::path& tmp) {
+            openvdb::io::File file(tmp.string());
+            file.write(list, meta);  // openvdb::Exception derives from std::exception
+            file.close();
+            digest = detail::digestFile(tmp);
+        });
+    });
     detail::writeManifest(path, digest);
 }
 

@@ -3,9 +3,10 @@
 #include "pine/bake/tree_grids.h"
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
+#include "pine/support/atomic_file.h"
+#include "pine/support/tool_main.h"
 
 #include <CLI/CLI.hpp>
-#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <sys/resource.h>
@@ -64,7 +65,7 @@ int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& setti
             const fs::path& out)
 {
     const auto start = std::chrono::steady_clock::now();
-    bake::checkWritable(out);  // before the work, not after it
+    io::checkWritable(out);  // before the work, not after it
     const scenes::Scene scene = scenes::loadScene(sceneFile);
     if (tree < 0 || std::size_t(tree) >= scene.trees.size()) {
         std::cerr << "bake: " << sceneFile.string() << ": no tree " << tree << " (the scene has "
@@ -87,7 +88,7 @@ fs::path treeFile(const fs::path& dir, std::size_t index)
 int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& settings, const fs::path& dir)
 {
     const auto start = std::chrono::steady_clock::now();
-    bake::checkWritable(treeFile(dir, 0));
+    io::checkWritable(treeFile(dir, 0));
     const scenes::Scene scene = scenes::loadScene(sceneFile);
     const std::size_t n = scene.trees.size();
     Totals totals;
@@ -112,9 +113,6 @@ int main(int argc, char** argv)
     CLI::App app{"bake: voxelize the boughs of a scene's trees into OpenVDB grids (density, "
                  "layer gradient and opacity, needle direction and albedo)"};
     app.require_subcommand(1);
-    int threads = 0;
-    app.add_option("--threads", threads, "Worker threads (default: all cores)")
-        ->check(CLI::NonNegativeNumber);
 
     fs::path sceneFile, out, outDir;
     int tree = 0;
@@ -149,29 +147,13 @@ int main(int argc, char** argv)
     addCommon(sceneCmd);
     sceneCmd->add_option("--out-dir", outDir, "Existing output folder")->required();
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        if (e.get_exit_code() == 0) return app.exit(e);  // --help
-        std::cerr << "bake: " << e.what() << " (see --help)\n";  // one line
-        return 2;
-    }
-    std::unique_ptr<tbb::global_control> limit;
-    if (threads > 0) {
-        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                      std::size_t(threads));
-    }
-    try {
-        if (*treeCmd) return bakeOne(sceneFile, tree, settings, out);
-        return bakeScene(sceneFile, settings, outDir);
-    } catch (const scenes::SceneError& e) {
-        std::cerr << "bake: " << e.what() << '\n';
-        return 2;
-    } catch (const bake::BakeError& e) {
-        std::cerr << (gProgressOpen ? "\n" : "") << "bake: " << e.what() << '\n';
-        return 2;
-    } catch (const std::exception& e) {
-        std::cerr << (gProgressOpen ? "\n" : "") << "bake: " << e.what() << '\n';
-        return 1;
-    }
+    return tool::run("bake", app, argc, argv, [&] {
+        try {
+            if (*treeCmd) return bakeOne(sceneFile, tree, settings, out);
+            return bakeScene(sceneFile, settings, outDir);
+        } catch (...) {
+            if (gProgressOpen.exchange(false)) std::fputc('\n', stderr);  // the error's own line
+            throw;
+        }
+    });
 }

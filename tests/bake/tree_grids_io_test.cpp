@@ -1,6 +1,7 @@
 // Writing and reading baked grids: round trip, what third-party tools see (vdb_print,
 // vdb_render, OpenVDB's own reader), and files we must refuse before OpenVDB parses them.
 #include "pine/bake/tree_grids.h"
+#include "pine/support/atomic_file.h"
 
 #include "test_support.h"
 
@@ -328,7 +329,7 @@ TEST(TreeGridsIo, UnwritableOutputIsABakeErrorAndLeavesNothing)
     const TreeGrids g = twoBoughs(0.8, 1);
     EXPECT_THROW(writeTreeGrids(g, dir.path() / "no" / "such" / "tree.vdb", kProvenance),
                  BakeError);
-    EXPECT_THROW(checkWritable(dir.path() / "no" / "tree.vdb"), BakeError);
+    EXPECT_THROW(io::checkWritable(dir.path() / "no" / "tree.vdb"), InputError);
     fs::create_directory(dir.path() / "folder.vdb");
     EXPECT_THROW(writeTreeGrids(g, dir.path() / "folder.vdb", kProvenance), BakeError);
     TreeGrids incomplete = g;

@@ -138,7 +138,13 @@ TEST(CompareRun, UnwritableFolderFailsBeforeWork)
     CompareOptions options;
     options.sceneFile = "/no/such/scene.json";  // never read: the folder is checked first
     options.outDir = "/proc/pine-cannot-write-here";
-    EXPECT_EQ(runCompare(options), 2);
+    try {
+        runCompare(options);
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("/proc/pine-cannot-write-here"), std::string::npos)
+            << e.what();
+    }
 }
 
 TEST(CompareRun, ParsesResolution)

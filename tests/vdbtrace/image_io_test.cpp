@@ -373,24 +373,6 @@ TEST_F(ImageIo, InconsistentImageIsRejected)
     EXPECT_TRUE(listing().empty());
 }
 
-TEST_F(ImageIo, CheckWritableRejectsMissingFolderAndAcceptsAWritableOne)
-{
-    try {
-        pine::vdbtrace::checkWritable(dir / "missing" / "frame.exr");
-        ADD_FAILURE() << "no ImageError for a missing folder";
-    } catch (const ImageError& error) {
-        EXPECT_NE(std::string(error.what()).find((dir / "missing").string()), std::string::npos)
-            << error.what();
-    }
-    std::ofstream(dir / "plain.txt") << "not a folder";
-    EXPECT_THROW(pine::vdbtrace::checkWritable(dir / "plain.txt" / "frame.exr"), ImageError);
-    EXPECT_THROW(pine::vdbtrace::checkWritable(dir), ImageError) << "a folder is no file";
-    EXPECT_THROW(pine::vdbtrace::checkWritable(""), ImageError);
-
-    EXPECT_NO_THROW(pine::vdbtrace::checkWritable(dir / "frame.exr"));
-    EXPECT_EQ(listing(), std::vector<std::string>{"plain.txt"}) << "the probe is removed";
-}
-
 TEST_F(ImageIo, ReadExrRejectsMissingAndNonExrFiles)
 {
     EXPECT_THROW(pine::vdbtrace::readExr(dir / "none.exr"), ImageError);

@@ -2,6 +2,7 @@
 
 #include "pine/bake/tree_boughs.h"
 #include "pine/scenes/scene.h"
+#include "pine/support/atomic_file.h"
 #include "pine/vdbtrace/flicker.h"
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image_diff.h"
@@ -55,20 +56,6 @@ std::string num(double v, int digits = 4)
     std::ostringstream s;
     s << std::setprecision(digits) << v;
     return s.str();
-}
-
-bool canWriteInto(const fs::path& dir)
-{
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    const fs::path probe = dir / ".write-test";
-    bool ok = false;
-    {
-        std::ofstream out(probe);
-        ok = bool(out << "x");
-    }
-    fs::remove(probe, ec);
-    return ok;
 }
 
 std::string cpuModel()
@@ -439,10 +426,7 @@ int runCompare(const CompareOptions& options)
 {
     const auto start = Clock::now();
     const fs::path& dir = options.outDir;
-    if (!canWriteInto(dir)) {
-        std::cerr << "vdbtrace compare: cannot write into " << dir.string() << '\n';
-        return 2;
-    }
+    io::checkWritableFolder(dir);
     const CompareSettings& st = options.settings;
     scenes::Scene scene = scenes::loadScene(options.sceneFile);
     if (options.width > 0 && options.height > 0) {
@@ -484,7 +468,7 @@ int runCompare(const CompareOptions& options)
         writePreviewPng(r.image, scene.render.background, dir / (r.stem() + ".png"));
         if (!r.truth) writeErrorPng(r.errors, c.errorScale, dir / (r.stem() + ".error.png"));
     }
-    writeTextAtomically(reportCsv(rows), dir / "report.csv");
+    io::writeTextAtomically(dir / "report.csv", reportCsv(rows));
 
     if (options.plot) {
         const std::string cmd = "MPLBACKEND=Agg /usr/bin/python3 '" + plotScript().string() +
@@ -503,9 +487,9 @@ int runCompare(const CompareOptions& options)
             std::cerr << "vdbtrace compare: flicker " << f.method << " " << num(f.flicker)
                       << '\n';
         }
-        writeTextAtomically(csv.str(), dir / "flicker.csv");
+        io::writeTextAtomically(dir / "flicker.csv", csv.str());
     }
-    writeTextAtomically(reportMd(rows, c), dir / "report.md");
+    io::writeTextAtomically(dir / "report.md", reportMd(rows, c));
 
     const Row* ms = find(rows, "multiscale", "auto");
     std::cerr << "vdbtrace compare: " << rows.size() << " renders";

@@ -4,15 +4,14 @@
 // half-written file under the final name (a rename within one folder is atomic on POSIX).
 #include "pine/vdbtrace/image.h"
 
+#include "pine/support/atomic_file.h"
+
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
-#include <random>
 #include <string_view>
 #include <system_error>
 
@@ -41,24 +40,6 @@ std::string oneLine(std::string text)
 {
     throw ImageError(std::string(what) + ": cannot write '" + path.string() + "': " +
                      oneLine(why));
-}
-
-std::string randomHex()
-{
-    // Seeded from the OS so concurrent writers (several renders into one folder) never pick
-    // the same temporary name.
-    static thread_local std::mt19937_64 engine{(std::uint64_t(std::random_device{}()) << 32) ^
-                                               std::random_device{}()};
-    char buffer[17];
-    std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(engine()));
-    return buffer;
-}
-
-// "<path>.tmp<random><ext>": same folder as the final file (so the rename stays within one
-// file system), and the real extension last because OIIO and viewers go by it.
-fs::path temporaryFor(const fs::path& path)
-{
-    return fs::path(path.string() + ".tmp" + randomHex() + path.extension().string());
 }
 
 void checkShape(const Image& image, const char* what, const fs::path& path)
@@ -106,8 +87,8 @@ bool isStandardAttribute(std::string_view key)
            key == "name" || key == "type" || key == "view" || key == "DateTime";
 }
 
-/// Writes `pixels` (interleaved, `spec.format`) with the OIIO plugin `format` to a temporary
-/// file, then renames it onto `path`. Removes the temporary on any failure.
+/// Writes pixels as `format` through the shared atomic writer (support/atomic_file.h): never
+/// half-written under `path`.
 void writeAtomically(const char* what, const char* format, const fs::path& path,
                      const OIIO::ImageSpec& spec, const void* pixels)
 {
@@ -115,29 +96,21 @@ void writeAtomically(const char* what, const char* format, const fs::path& path,
     // still write OpenEXR.
     auto out = OIIO::ImageOutput::create(format);
     if (!out) fail(what, path, OIIO::geterror());
-
-    fs::path temporary = temporaryFor(path);
-    for (int attempt = 0; attempt < 8 && fs::exists(temporary); ++attempt) {
-        temporary = temporaryFor(path);
+    try {
+        io::writeAtomically(path, [&](const fs::path& temporary) {
+            if (!out->open(temporary.string(), spec)) {
+                throw std::runtime_error(oneLine(out->geterror()));
+            }
+            if (!out->write_image(spec.format, pixels)) {
+                const std::string why = oneLine(out->geterror());
+                out->close();
+                throw std::runtime_error(why);
+            }
+            if (!out->close()) throw std::runtime_error(oneLine(out->geterror()));
+        });
+    } catch (const InputError& e) {
+        throw ImageError(std::string(what) + ": " + e.what());
     }
-    auto discard = [&](const std::string& why) {
-        std::error_code ignored;
-        fs::remove(temporary, ignored);
-        fail(what, path, why);
-    };
-
-    if (!out->open(temporary.string(), spec)) discard(out->geterror());
-    if (!out->write_image(spec.format, pixels)) {
-        std::string why = out->geterror();
-        out->close();
-        discard(why);
-    }
-    if (!out->close()) discard(out->geterror());
-    out.reset();
-
-    std::error_code error;
-    fs::rename(temporary, path, error);
-    if (error) discard("rename from '" + temporary.string() + "' failed: " + error.message());
 }
 
 std::uint8_t toByte(float value)
@@ -182,27 +155,6 @@ void writeBytesPng(const char* what, const fs::path& path, int width, int height
 }
 
 }  // namespace
-
-void checkWritable(const std::filesystem::path& path)
-{
-    auto refuse = [&](const std::string& why) {
-        throw ImageError("cannot write '" + path.string() + "': " + why);
-    };
-    if (path.empty()) refuse("the path is empty");
-    std::error_code error;
-    if (fs::is_directory(path, error)) refuse("it is a folder");
-    const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
-    if (!fs::is_directory(folder, error)) refuse("folder '" + folder.string() + "' is missing");
-
-    // Permission bits do not tell the whole story (read-only mounts, ACLs, root): try it.
-    const fs::path probe = folder / (".pine-write-probe-" + randomHex());
-    std::FILE* file = std::fopen(probe.c_str(), "wx");
-    if (!file) {
-        refuse("folder '" + folder.string() + "' is not writable: " + std::strerror(errno));
-    }
-    std::fclose(file);
-    fs::remove(probe, error);
-}
 
 void writeExr(const Image& image, const std::filesystem::path& path, const Metadata& metadata)
 {

@@ -1,9 +1,7 @@
 #include "pine/vdbtrace/stats_json.h"
 
-#include "pine/vdbtrace/image.h"
+#include "pine/support/atomic_file.h"
 
-#include <fstream>
-#include <random>
 
 namespace pine::vdbtrace {
 
@@ -39,26 +37,9 @@ nlohmann::json toJson(const EffectsPlan& p)
             {"self_shadowing", p.selfShadowing}};
 }
 
-void writeTextAtomically(const std::string& text, const std::filesystem::path& path)
-{
-    const std::filesystem::path tmp =
-        path.string() + ".tmp" + std::to_string(std::random_device{}());
-    {
-        std::ofstream out(tmp);
-        out << text;
-        out.close();
-        if (!out) {
-            std::error_code ec;
-            std::filesystem::remove(tmp, ec);
-            throw ImageError("cannot write " + path.string());
-        }
-    }
-    std::filesystem::rename(tmp, path);
-}
-
 void writeJsonAtomically(const nlohmann::json& json, const std::filesystem::path& path)
 {
-    writeTextAtomically(json.dump(2) + "\n", path);
+    io::writeTextAtomically(path, json.dump(2) + "\n");
 }
 
 }  // namespace pine::vdbtrace

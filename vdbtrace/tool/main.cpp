@@ -2,6 +2,8 @@
 #include "pine/bake/tree_boughs.h"
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
+#include "pine/support/atomic_file.h"
+#include "pine/support/tool_main.h"
 #include "pine/vdbtrace/compare.h"
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
@@ -13,7 +15,6 @@
 #include "pine/vdbtrace/traced_scene.h"
 
 #include <CLI/CLI.hpp>
-#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
 #include <sys/resource.h>
@@ -94,8 +95,8 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
                   << "' is not available (multiscale, reference, geometry)\n";
         return 2;
     }
-    vdbtrace::checkWritable(out);
-    if (!statsFile.empty()) vdbtrace::checkWritable(statsFile);
+    io::checkWritable(out);
+    if (!statsFile.empty()) io::checkWritable(statsFile);
     // Baked files first: a damaged one is refused before any work.
     const auto readStart = std::chrono::steady_clock::now();
     std::optional<bake::TreeGrids> baked;
@@ -249,7 +250,7 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
 {
     std::error_code ec;
     fs::create_directories(outDir, ec);
-    vdbtrace::checkWritable(outDir / "error.exr");
+    io::checkWritable(outDir / "error.exr");
     const vdbtrace::Image image = vdbtrace::readExr(a), reference = vdbtrace::readExr(b);
     const vdbtrace::ImageErrors errors = vdbtrace::compareImages(image, reference);
     const double shown = scale > 0.0 ? scale : std::max(errors.maxAbsolute, 1e-12);
@@ -273,9 +274,6 @@ int main(int argc, char** argv)
 {
     CLI::App app{"vdbtrace: the cone tracer of Meyer & Neyret's multiscale pine shaders"};
     app.require_subcommand(1);
-    int threads = 0;
-    app.add_option("--threads", threads, "Worker threads (default: all cores)")
-        ->check(CLI::NonNegativeNumber);
 
     fs::path sceneFile, out, statsFile;
     std::string method = "multiscale";
@@ -346,19 +344,7 @@ int main(int argc, char** argv)
         });
     compareCmd->add_flag("--no-plot", noPlot, "Skip error_vs_time.png (matplotlib)");
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        if (e.get_exit_code() == 0) return app.exit(e);  // --help
-        std::cerr << "vdbtrace: " << e.what() << " (see --help)\n";  // one line
-        return 2;
-    }
-    std::unique_ptr<tbb::global_control> limit;
-    if (threads > 0) {
-        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                      std::size_t(threads));
-    }
-    try {
+    return tool::run("vdbtrace", app, argc, argv, [&] {
         if (*renderCmd) {
             return render(sceneFile, method, out, statsFile, aovs, forceLevel, reference, samples);
         }
@@ -372,17 +358,5 @@ int main(int argc, char** argv)
             return vdbtrace::runCompare(compare);
         }
         return bench(sceneFile, scaling);
-    } catch (const scenes::SceneError& e) {
-        std::cerr << "vdbtrace: " << e.what() << '\n';
-        return 2;
-    } catch (const bake::BakeError& e) {
-        std::cerr << "vdbtrace: " << e.what() << '\n';
-        return 2;
-    } catch (const vdbtrace::ImageError& e) {
-        std::cerr << "vdbtrace: " << e.what() << '\n';
-        return 2;
-    } catch (const std::exception& e) {
-        std::cerr << "vdbtrace: " << e.what() << '\n';
-        return 1;
-    }
+    });
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "pine/bake/layer_field.h"
+#include "pine/support/input_error.h"
 
 #include <openvdb/openvdb.h>
 
@@ -14,9 +15,10 @@
 
 namespace pine::bake {
 
-class BakeError : public std::runtime_error {
+/// What bake throws: always about the user's input or output (a bough, a setting, a file).
+class BakeError : public InputError {
 public:
-    using std::runtime_error::runtime_error;
+    using InputError::InputError;
 };
 
 /// The fields a bake writes, in the file's order: density first, so that tools that take the
@@ -99,11 +101,6 @@ struct BakeProvenance {
     int tree = -1;
     unsigned seed = 0;
 };
-
-/// Throws BakeError (one line naming the path and why) unless a file can be created at
-/// `file`: its folder exists and takes a new file (tried, not guessed from permission bits).
-/// For tools, to refuse before the work rather than after it. (added)
-void checkWritable(const std::filesystem::path& file);
 
 /// Writes the grids atomically (temporary file in the same folder, then rename) with file
 /// metadata (format version, units, extinction law and its formula, voxel size, scene, tree,

@@ -3,6 +3,8 @@
 // file and radians in memory.
 #pragma once
 
+#include "pine/support/input_error.h"
+
 #include "pine/scenes/species.h"
 
 #include <glm/vec2.hpp>
@@ -21,9 +23,9 @@ using Vec2 = glm::dvec2;
 
 /// A scene file that cannot be used: the message is one line naming file, key and, where the
 /// parser gives it, line:column ("scenes/x.json:12:7: camera.fov_deg: must be in (0, 180)").
-class SceneError : public std::runtime_error {
+class SceneError : public InputError {
 public:
-    using std::runtime_error::runtime_error;
+    using InputError::InputError;
 };
 
 struct Camera {

@@ -34,8 +34,8 @@ struct CompareOptions {
 
 /// Runs the comparison into `outDir` (created): report.csv, report.md, flicker.csv, each image
 /// as EXR + PNG preview + error map, error_vs_time.png. Progress on stderr, one summary line
-/// last. Returns 0, or 2 with one line on stderr if `outDir` cannot be written (before any
-/// work). Failed plotting only warns. Throws what loading and rendering throw.
+/// last. Returns 0. Throws InputError if `outDir` cannot be written (before any work), and
+/// what loading and rendering throw. Failed plotting only warns.
 int runCompare(const CompareOptions& options);
 
 /// "WxH" -> width, height (both >= 1); false if malformed.

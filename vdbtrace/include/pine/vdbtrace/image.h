@@ -1,6 +1,8 @@
 // A rendered frame: premultiplied RGBA plus named single-channel AOVs, and how it is written.
 #pragma once
 
+#include "pine/support/input_error.h"
+
 #include <cstddef>
 #include <filesystem>
 #include <map>
@@ -34,14 +36,11 @@ struct Image {
 /// Key/value pairs stored in the file's header (render time, scene, method, settings, ...).
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 
-class ImageError : public std::runtime_error {
+/// What image reading and writing throw: about the user's input or output.
+class ImageError : public InputError {
 public:
-    using std::runtime_error::runtime_error;
+    using InputError::InputError;
 };
-
-/// Fails early (before a long render) if `path` cannot be written: its folder is missing or
-/// not writable. Throws ImageError naming the path.
-void checkWritable(const std::filesystem::path& path);
 
 /// OpenEXR, float: channels R, G, B, A and one channel per AOV named "<aov>.Y" (so that
 /// viewers show each AOV as a layer), metadata as string attributes. Written to a temporary

@@ -14,11 +14,7 @@ namespace pine::vdbtrace {
 nlohmann::json toJson(const RenderStats& stats);
 nlohmann::json toJson(const EffectsPlan& plan);
 
-/// Writes `text` to `path` through a temporary file in the same folder, then renames it: a
-/// reader never sees a half-written file. Throws ImageError naming the path.
-void writeTextAtomically(const std::string& text, const std::filesystem::path& path);
-
-/// The same for JSON, indented.
+/// Writes JSON, indented, atomically (io::writeTextAtomically). Throws InputError.
 void writeJsonAtomically(const nlohmann::json& json, const std::filesystem::path& path);
 
 }  // namespace pine::vdbtrace

@@ -1,0 +1,18 @@
+// The prologue and epilogue every executable shares (analytic, bake, vdbtrace): what a user
+// sees on --help, a bad option, --threads and an error is the same in all of them.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace pine::tool {
+
+/// Adds --threads to `app`, parses argv (--help prints and returns 0; a parse error prints one
+/// line "NAME: WHY (see --help)" and returns 2), limits TBB to the threads asked for, runs
+/// `body` and returns its status; what it throws becomes one line "NAME: WHAT" on stderr and
+/// status 2 for an InputError (the user's input or output), 1 for anything else.
+int run(const char* name, CLI::App& app, int argc, char** argv,
+        const std::function<int()>& body);
+
+}  // namespace pine::tool

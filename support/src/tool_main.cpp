@@ -1,0 +1,41 @@
+#include "pine/support/tool_main.h"
+
+#include "pine/support/input_error.h"
+
+#include <tbb/global_control.h>
+
+#include <iostream>
+#include <memory>
+
+namespace pine::tool {
+
+int run(const char* name, CLI::App& app, int argc, char** argv,
+        const std::function<int()>& body)
+{
+    int threads = 0;
+    app.add_option("--threads", threads, "Worker threads (default: all cores)")
+        ->check(CLI::NonNegativeNumber);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help
+        std::cerr << name << ": " << e.what() << " (see --help)\n";  // one line
+        return 2;
+    }
+    std::unique_ptr<tbb::global_control> limit;
+    if (threads > 0) {
+        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                      std::size_t(threads));
+    }
+    try {
+        return body();
+    } catch (const InputError& e) {
+        std::cerr << name << ": " << e.what() << '\n';
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << name << ": " << e.what() << '\n';
+        return 1;
+    }
+}
+
+}  // namespace pine::tool

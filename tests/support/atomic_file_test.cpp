@@ -1,0 +1,84 @@
+// The one atomic writer and writability probe every component and tool uses.
+#include "pine/support/atomic_file.h"
+
+#include "temp_dir.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <vector>
+
+namespace pine::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> listing(const fs::path& dir)
+{
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+std::string readFile(const fs::path& p)
+{
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(AtomicFile, AFailedWriteLeavesTheOldFileAndNoTemporary)
+{
+    const test::TempDir dir;
+    const fs::path file = dir.write("report.md", "old");
+    try {
+        writeAtomically(file, [](const fs::path& tmp) {
+            std::ofstream(tmp) << "half";
+            throw std::runtime_error("disk full");
+        });
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()), "cannot write '" + file.string() + "': disk full");
+    }
+    EXPECT_EQ(readFile(file), "old");
+    EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"report.md"});
+    writeTextAtomically(file, "new");
+    EXPECT_EQ(readFile(file), "new");
+    EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"report.md"});
+}
+
+TEST(AtomicFile, CheckWritableRejectsMissingFolderAndAcceptsAWritableOne)
+{
+    const test::TempDir dir;
+    try {
+        checkWritable(dir.path() / "missing" / "frame.exr");
+        ADD_FAILURE() << "no InputError for a missing folder";
+    } catch (const InputError& error) {
+        EXPECT_NE(std::string(error.what()).find((dir.path() / "missing").string()),
+                  std::string::npos)
+            << error.what();
+    }
+    dir.write("plain.txt", "not a folder");
+    EXPECT_THROW(checkWritable(dir.path() / "plain.txt" / "frame.exr"), InputError);
+    EXPECT_THROW(checkWritable(dir.path()), InputError) << "a folder is no file";
+    EXPECT_THROW(checkWritable(""), InputError);
+    EXPECT_NO_THROW(checkWritable(dir.path() / "frame.exr"));
+    EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"plain.txt"}) << "the probe is removed";
+}
+
+TEST(AtomicFile, CheckWritableFolderCreatesItOrSaysWhyNot)
+{
+    const test::TempDir dir;
+    EXPECT_NO_THROW(checkWritableFolder(dir.path() / "a" / "b"));
+    EXPECT_TRUE(fs::is_directory(dir.path() / "a" / "b"));
+    EXPECT_TRUE(listing(dir.path() / "a" / "b").empty());
+    dir.write("plain.txt", "not a folder");
+    EXPECT_THROW(checkWritableFolder(dir.path() / "plain.txt" / "c"), InputError);
+    EXPECT_THROW(checkWritableFolder("/proc/no-such-dir"), InputError);
+}
+
+}  // namespace
+}  // namespace pine::io
