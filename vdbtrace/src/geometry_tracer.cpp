@@ -515,6 +515,7 @@ RenderResult renderGeometry(const TracedScene& scene, const GeometryOptions& met
     if (method.built) method.built(geometry.build(buildSeconds));
     RenderResult result = renderImage(scene, geometry, options);
     result.seconds += buildSeconds;
+    result.prepSeconds += buildSeconds;
     return result;
 }
 

@@ -301,6 +301,7 @@ RenderResult renderReference(const TracedScene& scene, const bake::TreeGrids& gr
     const double prepSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     RenderResult result = renderImage(scene, reference, options);
     result.seconds += prepSeconds;
+    result.prepSeconds += prepSeconds;
     return result;
 }
 

@@ -8,6 +8,7 @@
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
+#include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/preview.h"
 #include "pine/vdbtrace/reference_tracer.h"
@@ -17,14 +18,21 @@
 #include <CLI/CLI.hpp>
 #include <tbb/task_arena.h>
 
+#include <spawn.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <thread>
+
+extern char** environ;
 
 namespace {
 
@@ -80,75 +88,45 @@ fs::path besideWith(const fs::path& image, const std::string& suffix)
     return p.string() + suffix;
 }
 
-struct ReferenceSettings {
-    double voxelSize_cm = 0.25;
-    int subpixels = 2;
-    std::vector<fs::path> grids;  ///< baked .vdb files; empty: bake the scene in memory
-};
-
-int render(const fs::path& sceneFile, const std::string& method, const fs::path& out,
-           const fs::path& statsFile, const std::vector<std::string>& aovs, int forceLevel,
-           const ReferenceSettings& reference, int samples)
+int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
+           const fs::path& statsFile, const std::vector<std::string>& aovs,
+           vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles)
 {
-    if (method != "multiscale" && method != "reference" && method != "geometry") {
-        std::cerr << "vdbtrace render: method '" << method
-                  << "' is not available (multiscale, reference, geometry)\n";
-        return 2;
-    }
+    const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
     io::checkWritable(out);
     if (!statsFile.empty()) io::checkWritable(statsFile);
     // Baked files first: a damaged one is refused before any work.
-    const auto readStart = std::chrono::steady_clock::now();
     std::optional<bake::TreeGrids> baked;
-    if (method == "reference" && !reference.grids.empty()) {
+    if (methodName == "reference" && !gridFiles.empty()) {
         std::vector<bake::TreeGrids> trees;
-        for (const fs::path& file : reference.grids) trees.push_back(bake::readTreeGrids(file));
-        baked = bake::mergeTreeGrids(trees);
+        for (const fs::path& file : gridFiles) trees.push_back(bake::readTreeGrids(file));
+        baked = bake::mergeTreeGrids(trees);  // files bake wrote, checked against manifests
+        settings.grids = &*baked;
+        std::cerr << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "
+                  << baked->voxelSize_cm << " cm read\n";
     }
     const auto loaded = load(sceneFile);
     std::cerr << "vdbtrace: " << sceneFile.string() << ": "
               << describe(loaded->scene, loaded->traced) << '\n';
-    vdbtrace::RenderResult result;
-    if (method == "multiscale") {
-        vdbtrace::MultiscaleOptions options;
-        options.forceLevel = forceLevel;
-        result = vdbtrace::renderMultiscale(loaded->traced, options, withProgress("rendering"));
-    } else if (method == "geometry") {
-        vdbtrace::GeometryOptions options;
-        options.samples = samples;
-        options.built = [](const vdbtrace::GeometryBuild& b) {
-            std::cerr << "vdbtrace: " << b.needles << " needles and " << b.branches
-                      << " branches as cylinders, BVH built in " << b.seconds << " s ("
-                      << double(b.primitiveBytes) / (1 << 20) << " MiB of cylinders, Embree peak "
-                      << double(b.embreePeakBytes) / (1 << 20) << " MiB)\n";
-        };
-        result = vdbtrace::renderGeometry(loaded->traced, options, withProgress("rendering"));
-    } else {
-        bake::TreeGrids grids;
-        if (baked) {
-            grids = *baked;  // files bake wrote, checked against their manifests
-        } else {
-            std::cerr << "vdbtrace: baking the boughs at " << reference.voxelSize_cm << " cm\n";
-            grids = bake::bakeScene(loaded->traced.trees,
-                                    vdbtrace::referenceBake(reference.voxelSize_cm));
-        }
-        std::cerr
-            << "vdbtrace: " << grids.layerOpacity->activeVoxelCount() << " voxels of "
-            << grids.voxelSize_cm << " cm in "
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - readStart).count()
-            << " s\n";
-        vdbtrace::ReferenceOptions options;
-        options.subpixels = reference.subpixels;
-        result = vdbtrace::renderReference(loaded->traced, grids, options,
-                                           withProgress("rendering"));
+    settings.geometry.built = [](const vdbtrace::GeometryBuild& b) {
+        std::cerr << "vdbtrace: " << b.needles << " needles and " << b.branches
+                  << " branches as cylinders, BVH built in " << b.seconds << " s ("
+                  << double(b.primitiveBytes) / (1 << 20) << " MiB of cylinders, Embree peak "
+                  << double(b.embreePeakBytes) / (1 << 20) << " MiB)\n";
+    };
+    if (methodName == "reference" && !baked) {
+        std::cerr << "vdbtrace: baking the boughs at " << settings.voxelSize_cm << " cm\n";
     }
+    const vdbtrace::RenderResult result =
+        method.render(loaded->traced, settings, withProgress("rendering"));
     std::cerr << '\n';
 
     const auto& s = loaded->scene;
     const nlohmann::json effects = vdbtrace::toJson(vdbtrace::EffectsPlan::from(s.effects));
-    const vdbtrace::Metadata metadata = {
+    const nlohmann::json methodSettings = method.describe(settings);
+    vdbtrace::Metadata metadata = {
         {"pine:scene", sceneFile.string()},
-        {"pine:method", method},
+        {"pine:method", methodName},
         {"pine:render_seconds", std::to_string(result.seconds)},
         {"pine:threads", std::to_string(tbb::this_task_arena::max_concurrency())},
         {"pine:effects", effects.dump()},
@@ -156,12 +134,10 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
                                       " cone<" + std::to_string(s.render.coneLevelMax) +
                                       " (footprint / cone spacing)"},
         {"pine:units", "cm"},
-        {"pine:reference", method == "reference"
-                               ? "voxel " + std::to_string(reference.voxelSize_cm) + " cm, " +
-                                     std::to_string(reference.subpixels * reference.subpixels) +
-                                     " rays per pixel, exact per voxel span"
-                               : "n/a"},
-        {"pine:samples", method == "geometry" ? std::to_string(samples) : "n/a"}};
+        {"pine:prep_seconds", std::to_string(result.prepSeconds)}};
+    for (const auto& [key, value] : methodSettings.items()) {
+        metadata.emplace_back("pine:" + key, value.dump());
+    }
     vdbtrace::writeExr(result.image, out, metadata);
     // The preview shows the scene's background behind what the cone did not cover.
     vdbtrace::writePreviewPng(result.image, s.render.background, besideWith(out, ".png"));
@@ -172,15 +148,11 @@ int render(const fs::path& sceneFile, const std::string& method, const fs::path&
         nlohmann::json j = vdbtrace::toJson(result.stats);
         j["seconds"] = result.seconds;
         j["scene"] = sceneFile.string();
-        j["method"] = method;
+        j["method"] = methodName;
         j["effects"] = effects;
         j["resolution"] = {s.camera.width, s.camera.height};
         j["threads"] = tbb::this_task_arena::max_concurrency();
-        if (method == "reference") {
-            j["voxel_size_cm"] = reference.voxelSize_cm;
-            j["rays_per_pixel"] = reference.subpixels * reference.subpixels;
-        }
-        if (method == "geometry") j["samples_per_pixel"] = samples;
+        j.update(methodSettings);
         vdbtrace::writeJsonAtomically(j, statsFile);
     }
     const auto& st = result.stats;
@@ -246,6 +218,39 @@ int bench(const fs::path& sceneFile, bool scaling)
     return 0;
 }
 
+std::string machineDescription()
+{
+    std::string cpu = "unknown CPU";
+    std::ifstream in("/proc/cpuinfo");
+    for (std::string line; std::getline(in, line);) {
+        const auto colon = line.find(':');
+        if (line.rfind("model name", 0) == 0 && colon != std::string::npos) {
+            cpu = line.substr(line.find_first_not_of(' ', colon + 1));
+            break;
+        }
+    }
+    return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) + " cores; " +
+           std::to_string(tbb::this_task_arena::max_concurrency()) + " threads";
+}
+
+/// scripts/plot_compare.py DIR (or $PINE_PLOT_SCRIPT) under Debian's python3, started without
+/// a shell: no part of a path is ever interpreted. True if it drew error_vs_time.png.
+bool plotCompare(const fs::path& dir)
+{
+    const char* env = std::getenv("PINE_PLOT_SCRIPT");
+    const std::string script =
+        env ? env : (fs::path(PINE_SOURCE_DIR) / "scripts" / "plot_compare.py").string();
+    const std::string python = "/usr/bin/python3", folder = dir.string();
+    ::setenv("MPLBACKEND", "Agg", 1);
+    char* argv[] = {const_cast<char*>(python.c_str()), const_cast<char*>(script.c_str()),
+                    const_cast<char*>(folder.c_str()), nullptr};
+    pid_t pid;
+    if (::posix_spawn(&pid, python.c_str(), nullptr, nullptr, argv, environ) != 0) return false;
+    int status = 0;
+    if (::waitpid(pid, &status, 0) != pid) return false;
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::exists(dir / "error_vs_time.png");
+}
+
 int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double scale)
 {
     std::error_code ec;
@@ -278,31 +283,34 @@ int main(int argc, char** argv)
     fs::path sceneFile, out, statsFile;
     std::string method = "multiscale";
     std::vector<std::string> aovs;
-    int forceLevel = 0;
     auto* renderCmd = app.add_subcommand("render", "Render a scene to EXR (+ PNG preview)");
     renderCmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
-    renderCmd->add_option("--method", method,
-                          "multiscale (closed forms), reference (equation 7 through OpenVDB "
-                          "grids), geometry (explicit needle cylinders, the ground truth)");
-    ReferenceSettings reference;
-    renderCmd->add_option("--voxel-size", reference.voxelSize_cm,
+    std::string methods;
+    for (const vdbtrace::RenderMethod& m : vdbtrace::renderMethods()) {
+        methods += (methods.empty() ? "" : "; ") + std::string(m.name) + ": " + m.description;
+    }
+    renderCmd->add_option("--method", method, methods);
+    vdbtrace::MethodSettings settings;
+    std::vector<fs::path> gridFiles;
+    renderCmd->add_option("--voxel-size", settings.voxelSize_cm,
                           "reference: voxel size of the baked boughs, cm")
         ->check(CLI::PositiveNumber);
-    renderCmd->add_option("--grids", reference.grids,
+    renderCmd->add_option("--grids", gridFiles,
                           "reference: baked .vdb files (bake tree/scene) instead of baking now")
         ->check(CLI::ExistingFile);
-    renderCmd->add_option("--subpixels", reference.subpixels,
+    renderCmd->add_option("--subpixels", settings.reference.subpixels,
                           "reference: rays per pixel along each axis (the cone's footprint)")
         ->check(CLI::Range(1, 16));
-    int samples = 16;
-    renderCmd->add_option("--samples", samples, "geometry: point samples per pixel")
+    renderCmd->add_option("--samples", settings.geometry.samples,
+                          "geometry: point samples per pixel")
         ->check(CLI::Range(1, 65536));
     renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")
         ->required();
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
         ->check(CLI::IsMember({"level"}));
-    renderCmd->add_option("--force-level", forceLevel, "Shade every bough hit at level 1, 2 or 3")
+    renderCmd->add_option("--force-level", settings.multiscale.forceLevel,
+                          "multiscale: shade every bough hit at level 1, 2 or 3")
         ->check(CLI::Range(0, 3));
 
     bool scaling = false;
@@ -346,16 +354,21 @@ int main(int argc, char** argv)
 
     return tool::run("vdbtrace", app, argc, argv, [&] {
         if (*renderCmd) {
-            return render(sceneFile, method, out, statsFile, aovs, forceLevel, reference, samples);
+            return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles);
         }
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
         if (*compareCmd) {
             compare.settings = vdbtrace::CompareSettings::forQuick(quick);
-            compare.plot = !noPlot;
+            compare.machine = machineDescription();
+            compare.log = [](const std::string& line) {
+                std::cerr << "vdbtrace compare: " << line << '\n';
+            };
+            if (!noPlot) compare.plot = plotCompare;
             if (!resolution.empty()) {
                 vdbtrace::parseResolution(resolution, compare.width, compare.height);
             }
-            return vdbtrace::runCompare(compare);
+            vdbtrace::runCompare(compare);
+            return 0;
         }
         return bench(sceneFile, scaling);
     });

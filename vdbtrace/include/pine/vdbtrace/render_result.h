@@ -23,7 +23,8 @@ struct RenderOptions {
 struct RenderResult {
     Image image;  ///< premultiplied RGBA plus kAovNames
     RenderStats stats;
-    double seconds = 0.0;  ///< wall clock, including what the method prepares (BVH, bake)
+    double seconds = 0.0;      ///< wall clock, including what the method prepares first
+    double prepSeconds = 0.0;  ///< of `seconds`, that preparation (BVH, bake, light grids)
 };
 
 }  // namespace pine::vdbtrace

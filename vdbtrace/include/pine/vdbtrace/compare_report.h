@@ -1,0 +1,39 @@
+// `vdbtrace compare`, the report: what runComparison measured, as a person and a plot script
+// read it (report.csv, report.md, flicker.csv, each image with its error map).
+#pragma once
+
+#include "pine/vdbtrace/compare_run.h"
+#include "pine/vdbtrace/dolly.h"
+
+#include <filesystem>
+#include <string>
+
+namespace pine::vdbtrace {
+
+/// What the report says besides the rows.
+struct ReportInfo {
+    std::filesystem::path sceneFile;
+    const scenes::Scene* scene = nullptr;  ///< as rendered (its resolution)
+    CompareSettings settings;
+    std::string machine;              ///< CPU, cores and threads, as the tool found them
+    double errorScale = 1.0;          ///< luminance error shown white in every error map
+    bool plotted = false;             ///< error_vs_time.png exists
+    const DollyFlicker* flicker = nullptr;  ///< null: no dolly was rendered
+};
+
+/// One row a render: method, setting, seconds, errors (overall and by level), prep seconds.
+std::string reportCsv(const std::vector<CompareRow>& rows);
+std::string flickerCsv(const DollyFlicker& flicker);
+std::string reportMd(const CompareRun& run, const ReportInfo& info);
+
+/// The error maps' common scale: the 99th percentile of every pixel's error over all renders
+/// but the truth, so one outlier does not darken every map and equal colours mean equal error.
+double commonErrorScale(const std::vector<CompareRow>& rows);
+
+/// Each row's EXR (with its method and setting in the header), PNG preview over `background`
+/// and, but for the truth, its error map at `errorScale`, into `dir`.
+void writeRowImages(const CompareRun& run, const std::filesystem::path& sceneFile,
+                    const scenes::Vec3& background, double errorScale,
+                    const std::filesystem::path& dir);
+
+}  // namespace pine::vdbtrace

@@ -1,0 +1,42 @@
+// The methods a user chooses by name (`vdbtrace render --method`, `vdbtrace compare`): one
+// registry, so that both run a method the same way and describe its settings the same way.
+#pragma once
+
+#include "pine/bake/tree_grids.h"
+#include "pine/vdbtrace/geometry_tracer.h"
+#include "pine/vdbtrace/multiscale_tracer.h"
+#include "pine/vdbtrace/reference_tracer.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace pine::vdbtrace {
+
+/// Every method's settings; each method reads its own.
+struct MethodSettings {
+    MultiscaleOptions multiscale;
+    ReferenceOptions reference;
+    double voxelSize_cm = 0.25;              ///< reference: the bake's voxel, without `grids`
+    const bake::TreeGrids* grids = nullptr;  ///< reference: grids read from files instead
+    GeometryOptions geometry;
+};
+
+struct RenderMethod {
+    const char* name;
+    const char* description;  ///< one line, for --help
+    /// Renders the scene's camera; result.seconds includes what the method prepares first
+    /// (the reference's bake, the geometry's BVH), reported in result.prepSeconds.
+    RenderResult (*render)(const TracedScene& scene, const MethodSettings& settings,
+                           const RenderOptions& options);
+    /// The settings the method reads, as the stats JSON and the EXR header record them.
+    nlohmann::json (*describe)(const MethodSettings& settings);
+};
+
+/// The registered methods: multiscale, reference, geometry.
+const std::vector<RenderMethod>& renderMethods();
+/// The method named `name`; throws InputError naming the registered ones.
+const RenderMethod& renderMethod(const std::string& name);
+
+}  // namespace pine::vdbtrace

@@ -1,0 +1,73 @@
+#include "pine/vdbtrace/methods.h"
+
+#include <chrono>
+
+namespace pine::vdbtrace {
+namespace {
+
+RenderResult multiscale(const TracedScene& scene, const MethodSettings& s,
+                        const RenderOptions& options)
+{
+    return renderMultiscale(scene, s.multiscale, options);
+}
+
+nlohmann::json describeMultiscale(const MethodSettings&) { return nlohmann::json::object(); }
+
+RenderResult reference(const TracedScene& scene, const MethodSettings& s,
+                       const RenderOptions& options)
+{
+    if (s.grids) return renderReference(scene, *s.grids, s.reference, options);
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    const bake::TreeGrids grids =
+        bake::bakeBoughs(boughSpecs(scene), referenceBake(s.voxelSize_cm));
+    const double bakeSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    RenderResult result = renderReference(scene, grids, s.reference, options);
+    result.seconds += bakeSeconds;
+    result.prepSeconds += bakeSeconds;
+    return result;
+}
+
+nlohmann::json describeReference(const MethodSettings& s)
+{
+    return {{"voxel_size_cm", s.grids ? s.grids->voxelSize_cm : s.voxelSize_cm},
+            {"rays_per_pixel", s.reference.subpixels * s.reference.subpixels}};
+}
+
+RenderResult geometry(const TracedScene& scene, const MethodSettings& s,
+                      const RenderOptions& options)
+{
+    return renderGeometry(scene, s.geometry, options);
+}
+
+nlohmann::json describeGeometry(const MethodSettings& s)
+{
+    return {{"samples_per_pixel", s.geometry.samples}};
+}
+
+}  // namespace
+
+const std::vector<RenderMethod>& renderMethods()
+{
+    static const std::vector<RenderMethod> methods = {
+        {"multiscale", "closed forms, each hit at the level its footprint calls for",
+         multiscale, describeMultiscale},
+        {"reference", "equation 7 numerically through OpenVDB grids of the boughs", reference,
+         describeReference},
+        {"geometry", "explicit needle cylinders, point samples (the ground truth)", geometry,
+         describeGeometry},
+    };
+    return methods;
+}
+
+const RenderMethod& renderMethod(const std::string& name)
+{
+    std::string known;
+    for (const RenderMethod& m : renderMethods()) {
+        if (m.name == name) return m;
+        known += (known.empty() ? "" : ", ") + std::string(m.name);
+    }
+    throw InputError("method '" + name + "' is not available (" + known + ")");
+}
+
+}  // namespace pine::vdbtrace
