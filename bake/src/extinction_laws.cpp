@@ -1,9 +1,8 @@
 // The registry of extinction laws: to add one, write its type in a file of its own (as
-// layer_extinction_law.cpp), declare its factory here and add a row to the table.
+// layer_extinction_law.cpp), declare its factory here and add it to the table.
 #include "pine/bake/extinction_law.h"
-#include "pine/bake/tree_grids.h"
 
-#include <memory>
+#include "pine/support/registry.h"
 
 namespace pine::bake {
 
@@ -11,16 +10,11 @@ std::unique_ptr<ExtinctionLaw> makeLayerExtinctionLaw();
 
 namespace {
 
-struct Registered {
-    std::string name;
-    std::unique_ptr<ExtinctionLaw> law;
-};
-
-const std::vector<Registered>& registry()
+const Registry<ExtinctionLaw>& registry()
 {
-    static const std::vector<Registered> laws = [] {
-        std::vector<Registered> r;
-        r.push_back({"layer", makeLayerExtinctionLaw()});  // section 6's layers (the default)
+    static const Registry<ExtinctionLaw> laws = [] {
+        Registry<ExtinctionLaw> r("extinction law");
+        r.add("layer", makeLayerExtinctionLaw());  // section 6's layers (the default)
         return r;
     }();
     return laws;
@@ -28,21 +22,8 @@ const std::vector<Registered>& registry()
 
 }  // namespace
 
-const ExtinctionLaw& extinctionLaw(const std::string& name)
-{
-    std::string known;
-    for (const Registered& r : registry()) {
-        if (r.name == name) return *r.law;
-        known += (known.empty() ? "" : ", ") + r.name;
-    }
-    throw BakeError("unknown extinction law '" + name + "' (known: " + known + ")");
-}
+const ExtinctionLaw& extinctionLaw(const std::string& name) { return registry().get(name); }
 
-std::vector<std::string> extinctionLawNames()
-{
-    std::vector<std::string> names;
-    for (const Registered& r : registry()) names.push_back(r.name);
-    return names;
-}
+std::vector<std::string> extinctionLawNames() { return registry().names(); }
 
 }  // namespace pine::bake

@@ -98,7 +98,7 @@ void checkFileMetadata(const openvdb::MetaMap* meta, const fs::path& path)
     if (!law) throw refuse("no " + std::string(kExtinctionLawKey));
     try {
         extinctionLaw(law->value());
-    } catch (const BakeError& e) {
+    } catch (const InputError& e) {
         throw refuse(e.what());
     }
 }
@@ -180,7 +180,8 @@ TreeGrids readTreeGrids(const fs::path& path)
         }
     }
     for (int level = 1;; ++level) {
-        auto lod = openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(*grids, densityLodName(level)));
+        auto lod =
+            openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(*grids, densityLodName(level)));
         if (!lod) break;
         out.densityPyramid.push_back(lod);
     }

@@ -9,7 +9,6 @@
 #include <CLI/CLI.hpp>
 #include <tbb/parallel_for.h>
 
-#include <sys/resource.h>
 
 #include <atomic>
 #include <chrono>
@@ -23,13 +22,6 @@ namespace {
 
 using namespace pine;
 namespace fs = std::filesystem;
-
-double peakMemoryMiB()
-{
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return double(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
-}
 
 /// Set once a progress line is on stderr without its newline: an error then starts a new line.
 std::atomic<bool> gProgressOpen{false};
@@ -58,7 +50,8 @@ void summarize(const Totals& totals, std::chrono::steady_clock::time_point start
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr, "bake: %zu trees, %llu voxels, %llu bytes, %.2f s, peak %.0f MiB\n",
                  totals.trees.load(), static_cast<unsigned long long>(totals.voxels.load()),
-                 static_cast<unsigned long long>(totals.bytes.load()), seconds, peakMemoryMiB());
+                 static_cast<unsigned long long>(totals.bytes.load()), seconds,
+                 tool::peakMemoryMiB());
 }
 
 int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& settings,

@@ -2,6 +2,7 @@
 
 #include "pine/support/input_error.h"
 
+#include <sys/resource.h>
 #include <tbb/global_control.h>
 
 #include <iostream>
@@ -36,6 +37,13 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
         std::cerr << name << ": " << e.what() << '\n';
         return 1;
     }
+}
+
+double peakMemoryMiB()
+{
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
 }
 
 }  // namespace pine::tool

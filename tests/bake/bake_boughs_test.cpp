@@ -49,8 +49,10 @@ TEST(BakeBoughs, MassOfALongBoughMatchesTheIntegral)
     // So each error must stay under bound / 10, and the mean over sub-voxel shifts of the bough
     // must shrink with h. The axis is oblique so that no face lines up with the voxels.
     const BoughSpec b = test::paperBough(Vec3(0.3, -0.7, 0.1), Vec3(0.3, 0.5, 0.8), 60.0);
-    const double phi = b.needles.cone.aperture_rad, R = b.needles.cone.needleLength_cm * std::sin(phi), L = 60.0;
-    const double A = 2.0 * b.needles.cone.needlesPerCone * b.needles.cone.needleRadius_cm / (kPi * R);
+    const double phi = b.needles.cone.aperture_rad,
+                 R = b.needles.cone.needleLength_cm * std::sin(phi), L = 60.0;
+    const double A =
+        2.0 * b.needles.cone.needlesPerCone * b.needles.cone.needleRadius_cm / (kPi * R);
     const double mu = -std::log(1.0 - A);
     const double exact = mu / (2.0 * b.needles.coneSpacing_cm * std::sin(phi)) * kPi * R * R * L;
     const double surfaceOverVolume = 2.0 / R + 2.0 / (L * std::sin(phi));

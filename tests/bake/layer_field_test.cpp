@@ -52,9 +52,11 @@ TEST(LayerField, MeanOverTheSphereIsHalfTheGradientNorm)
         const double mean = sum / kPoints;
         EXPECT_NEAR(mean / layerLaw().meanExtinction(*s), 1.0, 1e-4) << "phi " << phi;
         // |G| = |axis - cot(phi) radial| / dh = 1 / (dh sin(phi)).
-        EXPECT_NEAR(glm::length(s->gradient) * b.needles.coneSpacing_cm * std::sin(phi), 1.0, 1e-12);
+        EXPECT_NEAR(glm::length(s->gradient) * b.needles.coneSpacing_cm * std::sin(phi), 1.0,
+                    1e-12);
         const double mu = -std::log(1.0 - s->layerOpacity);
-        EXPECT_NEAR(layerLaw().meanExtinction(*s), mu / (2.0 * b.needles.coneSpacing_cm * std::sin(phi)), 1e-12);
+        EXPECT_NEAR(layerLaw().meanExtinction(*s),
+                    mu / (2.0 * b.needles.coneSpacing_cm * std::sin(phi)), 1e-12);
     }
 }
 
@@ -124,7 +126,8 @@ TEST(LayerField, ChordThroughTheAxisCrossesAsManyConesAsItCounts)
     ASSERT_GT(mu, 0.0);
     EXPECT_NEAR(sumDepth / mu / kOffsets, sumCount / kOffsets, 2.0 / kOffsets + 1e-3);
     // And both are the exact 2 R cot(phi) / dh (4.36 per half on the paper's bough).
-    EXPECT_NEAR(sumCount / kOffsets, 2.0 * R / std::tan(b.needles.cone.aperture_rad) / b.needles.coneSpacing_cm,
+    EXPECT_NEAR(sumCount / kOffsets,
+                2.0 * R / std::tan(b.needles.cone.aperture_rad) / b.needles.coneSpacing_cm,
                 2.0 / kOffsets);
 }
 

@@ -219,8 +219,10 @@ TEST(GeometryTracer, NeedleLevelCountsEachNeedleOnceWhenConesAreSparse)
             covered[0] += multiscale.image.aovs.at("foliage")[i];
             covered[1] += geometry.image.aovs.at("foliage")[i];
         }
-        EXPECT_LT(covered[0] / covered[1], 1.04) << perCone << ": " << covered[0] << " " << covered[1];
-        EXPECT_GT(covered[0] / covered[1], 0.5) << perCone << ": " << covered[0] << " " << covered[1];
+        EXPECT_LT(covered[0] / covered[1], 1.04)
+            << perCone << ": " << covered[0] << " " << covered[1];
+        EXPECT_GT(covered[0] / covered[1], 0.5)
+            << perCone << ": " << covered[0] << " " << covered[1];
     }
 }
 

@@ -40,13 +40,15 @@ void expectBounded(const Image& image, const std::string& what)
         }
     }
     for (const float level : image.aovs.at("level")) {
-        ASSERT_TRUE(level == 0.0f || (level >= 1.0f && level <= 3.0f)) << what << " level " << level;
+        ASSERT_TRUE(level == 0.0f || (level >= 1.0f && level <= 3.0f))
+            << what << " level " << level;
     }
 }
 
 TEST(MultiscaleTracer, CompositingStaysBoundedAndUsesEveryLevel)
 {
-    const RenderResult r = render(firScene(R"("diffuse", "specular", "shadows", "self_shadowing")"));
+    const RenderResult r =
+        render(firScene(R"("diffuse", "specular", "shadows", "self_shadowing")"));
     expectBounded(r.image, "fir");
     EXPECT_GT(r.stats.needleHits, 0u);
     EXPECT_GT(r.stats.coneHits, 0u);
@@ -138,7 +140,8 @@ struct SideOnBough {
   "camera": {"position": [0, -30, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 30,
              "resolution": [120, 90]},
   "lights": [{"type": "directional", "direction": [0, -1, 0.2]}],
-  "ground": {"type": "none"}, "species": {}, "trees": [], "effects": ["diffuse"]})", "side-on.json");
+  "ground": {"type": "none"}, "species": {}, "trees": [], "effects": ["diffuse"]})",
+                                   "side-on.json");
         traced = buildTracedScene(scene);
         BoughDescription d;
         d.spec.base_cm = Vec3(-40, 0, 0);
@@ -167,14 +170,17 @@ TEST(MultiscaleTracer, ConeLevelCrossesTheTrueCones)
     const TracedBough& b = s.traced.boughs.front();
     const ConeCamera camera(s.scene.camera);
     const double T = 1.0 - b.layerOpacity, R = b.radius_cm;
-    const double cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad), dh = b.geometry.coneSpacing_cm;
+    const double cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad),
+                 dh = b.geometry.coneSpacing_cm;
     int rows = 0;
     for (int y = 0; y < camera.height(); ++y) {
         Passage p;
         const ConeRay ray = camera.cone(camera.width() / 2, y);
-        if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap + 0.5 * ray.width(p.t) > R) continue;
+        if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap + 0.5 * ray.width(p.t) > R)
+            continue;
         const double n = 2.0 * (R - p.gap) * cotPhi / dh, f = n - std::floor(n);
-        const double expected = 1.0 - ((1 - f) * std::pow(T, std::floor(n)) + f * std::pow(T, std::floor(n) + 1));
+        const double expected =
+            1.0 - ((1 - f) * std::pow(T, std::floor(n)) + f * std::pow(T, std::floor(n) + 1));
         double mean = 0.0;
         const int x0 = camera.width() / 4, x1 = 3 * camera.width() / 4;  // away from the ends
         for (int x = x0; x < x1; ++x) mean += r.image.pixel(x, y)[3];

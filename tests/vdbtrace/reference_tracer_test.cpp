@@ -26,7 +26,8 @@ struct SideOn {
     {
         scene = scenes::parseScene(R"({"name": "side-on bough",
   "camera": {"position": [0, -30, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 12,
-             "resolution": [)" + std::to_string(height * 4 / 3) + ", " + std::to_string(height) + R"(]},
+             "resolution": [)" + std::to_string(height * 4 / 3) +
+                                       ", " + std::to_string(height) + R"(]},
   "lights": [{"type": "directional", "direction": [0, -1, 0.3]}],
   "ground": {"type": "none"}, "species": {}, "trees": [], "effects": ["diffuse"]})",
                                    "side-on.json");
@@ -62,7 +63,8 @@ double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
         Passage p;
         if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap > 0.9 * R) continue;
         const double cosV = glm::dot(-ray.direction, b.axis);
-        const double layers = analytic::trueConeLayers(b.geometry, cosV, std::sqrt(1 - cosV * cosV), p.gap / R);
+        const double layers =
+            analytic::trueConeLayers(b.geometry, cosV, std::sqrt(1 - cosV * cosV), p.gap / R);
         sum += std::abs(r.image.pixel(camera.width() / 2, y)[3] - (1.0 - std::exp(-mu * layers)));
         ++rows;
     }
@@ -106,7 +108,8 @@ TEST(ImageDiff, MeasuresKnownErrors)
     for (int x = 0; x < 4; ++x) {
         for (int y = 0; y < 2; ++y) {
             for (int c = 0; c < 3; ++c) b.pixel(x, y)[c] = 0.5f;
-            for (int c = 0; c < 3; ++c) a.pixel(x, y)[c] = x == 0 ? 0.7f : 0.5f;  // 2 of 8 pixels off by 0.2
+            for (int c = 0; c < 3; ++c)
+                a.pixel(x, y)[c] = x == 0 ? 0.7f : 0.5f;  // 2 of 8 pixels off by 0.2
         }
     }
     const ImageErrors e = compareImages(a, b);

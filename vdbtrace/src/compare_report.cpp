@@ -26,14 +26,15 @@ std::string speedSection(const std::vector<CompareRow>& rows)
     for (const CompareRow& r : rows) {
         if (r.method == "geometry" && (!best || r.errors.rmse < best->errors.rmse)) best = &r;
     }
-    s << "Multiscale (auto): RMSE " << formatNumber(ms->errors.rmse) << " in " << formatNumber(ms->seconds, 3)
-      << " s.\n\n";
+    s << "Multiscale (auto): RMSE " << formatNumber(ms->errors.rmse) << " in "
+      << formatNumber(ms->seconds, 3) << " s.\n\n";
     if (cheapest) {
         const double ratio = cheapest->seconds / ms->seconds;
         s << "The cheapest geometry setting at equal or lower RMSE is " << cheapest->setting
-          << " (RMSE " << formatNumber(cheapest->errors.rmse) << ", " << formatNumber(cheapest->seconds, 3)
-          << " s, its BVH included): speed ratio (geometry s / multiscale s) **" << formatNumber(ratio, 3)
-          << "**, i.e. "
+          << " (RMSE " << formatNumber(cheapest->errors.rmse) << ", "
+          << formatNumber(cheapest->seconds, 3)
+          << " s, its BVH included): speed ratio (geometry s / multiscale s) **"
+          << formatNumber(ratio, 3) << "**, i.e. "
           << (ratio >= 1.0 ? "multiscale is " + formatNumber(ratio, 3) + " times faster"
                            : "the geometry is " + formatNumber(1.0 / ratio, 3) + " times faster")
           << " at equal or lower error.\n";
@@ -172,20 +173,21 @@ std::string reportMd(const CompareRun& run, const ReportInfo& c)
     for (double h : st.voxelSizes_cm) s << ' ' << formatNumber(h);
     s << " cm, " << st.subpixels * st.subpixels << " rays per pixel; multiscale: levels forced "
       << "to 1, 2, 3 and automatic\n";
-    s << "- scene build (trees grown, BVH, per-bough shading): " << formatNumber(run.buildSeconds, 3)
-      << " s, once, excluded from every time below\n\n";
+    s << "- scene build (trees grown, BVH, per-bough shading): "
+      << formatNumber(run.buildSeconds, 3) << " s, once, excluded from every time below\n\n";
     s << "## Error against time\n\n"
          "Seconds: wall clock of each render alone, including what the method alone needs "
-         "first (prep: the geometry's Embree BVH, the reference's bake and light grids). Errors: linear "
+         "first (prep: the geometry's Embree BVH, the reference's bake and light grids). Errors: "
+         "linear "
          "luminance of premultiplied RGB against the ground truth (`compareImages`): RMSE over "
          "all pixels, mean relative over pixels brighter than 1% of the truth's mean, maximum, "
          "and for multiscale the RMSE over the pixels of each level.\n\n";
     s << "| method | setting | seconds | prep s | RMSE | mean relative | max | RMSE needle | "
          "RMSE cone | RMSE bough |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for (const CompareRow& r : rows) {
-        s << "| " << r.method << " | " << r.setting << " | "
-          << formatNumber(r.seconds, 3) << " | " << (r.prepSeconds ? formatNumber(*r.prepSeconds, 3) : "")
-          << " | " << formatNumber(r.errors.rmse) << " | " << formatNumber(r.errors.meanRelative) << " | "
+        s << "| " << r.method << " | " << r.setting << " | " << formatNumber(r.seconds, 3) << " | "
+          << (r.prepSeconds ? formatNumber(*r.prepSeconds, 3) : "") << " | "
+          << formatNumber(r.errors.rmse) << " | " << formatNumber(r.errors.meanRelative) << " | "
           << formatNumber(r.errors.maxAbsolute);
         for (int level = 1; level <= 3; ++level) {
             s << " | ";
@@ -217,7 +219,8 @@ std::string reportMd(const CompareRun& run, const ReportInfo& c)
         s << "\n## Temporal aliasing\n\n"
           << st.frames << " frames at " << c.flicker->width << " x " << c.flicker->height
           << ", the camera dollying away from its look-at point (distance x 1 to x "
-          << formatNumber(st.dollyEnd) << "). **Flicker** = mean over pixels of the standard deviation, "
+          << formatNumber(st.dollyEnd)
+          << "). **Flicker** = mean over pixels of the standard deviation, "
           << "over the frames, of the pixel's luminance (premultiplied RGB) about its "
           << "least-squares line in the frame index: the smooth change the dolly causes is "
           << "removed, the frame-to-frame jumps of aliasing needles remain. Edges that move "

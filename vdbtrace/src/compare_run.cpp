@@ -59,7 +59,8 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
         if (log) {
             std::string line = row.method + " " + row.setting + ": " +
                                formatNumber(row.seconds, 3) + " s";
-            if (row.prepSeconds) line += " (" + formatNumber(*row.prepSeconds, 3) + " s preparation)";
+            if (row.prepSeconds)
+                line += " (" + formatNumber(*row.prepSeconds, 3) + " s preparation)";
             if (!row.truth) line += ", rmse " + formatNumber(row.errors.rmse);
             log(line);
         }
@@ -67,7 +68,8 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
     };
     MethodSettings s;
     s.geometry.samples = st.truthSamples;
-    CompareRow truth = render(traced, "geometry", "truth", std::to_string(st.truthSamples) + "spp", s);
+    CompareRow truth =
+        render(traced, "geometry", "truth", std::to_string(st.truthSamples) + "spp", s);
     truth.truth = true;
     measure(std::move(truth));
     for (int n : st.geometrySamples) {

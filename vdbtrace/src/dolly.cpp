@@ -39,7 +39,8 @@ DollyFlicker measureDollyFlicker(const scenes::Scene& base, const CompareSetting
         }
         if (log) log("dolly frame " + std::to_string(f + 1) + "/" + std::to_string(s.frames));
     }
-    for (std::size_t m = 0; m < out.rows.size(); ++m) out.rows[m].flicker = temporalFlicker(frames[m]);
+    for (std::size_t m = 0; m < out.rows.size(); ++m)
+        out.rows[m].flicker = temporalFlicker(frames[m]);
     return out;
 }
 

@@ -19,7 +19,6 @@
 #include <tbb/task_arena.h>
 
 #include <spawn.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 
 #include <chrono>
@@ -38,13 +37,6 @@ namespace {
 
 using namespace pine;
 namespace fs = std::filesystem;
-
-double peakMemoryMiB()
-{
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return double(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
-}
 
 vdbtrace::RenderOptions withProgress(const std::string& what)
 {
@@ -192,7 +184,7 @@ int bench(const fs::path& sceneFile, bool scaling)
               << scene.camera.height << ", threads " << tbb::this_task_arena::max_concurrency()
               << "\nscene build seconds (trees grown, BVH, per-bough shading) " << buildSeconds
               << "\nrender seconds " << r.seconds << "\ncone rays per second " << pixels / r.seconds
-              << "\npeak memory MiB " << peakMemoryMiB() << "\nshare of pixels: none "
+              << "\npeak memory MiB " << tool::peakMemoryMiB() << "\nshare of pixels: none "
               << share(0) << ", needle " << share(1) << ", cone " << share(2) << ", bough "
               << share(3) << '\n';
     if (!scaling) return 0;

@@ -22,7 +22,7 @@ public:
     virtual double meanExtinction(const LayerSample& field) const = 0;
 };
 
-/// The law registered as `name`; throws BakeError naming the registered ones.
+/// The law registered as `name`; throws InputError naming the registered ones.
 const ExtinctionLaw& extinctionLaw(const std::string& name);
 /// The registered names, in registration order (the first is the default).
 std::vector<std::string> extinctionLawNames();

@@ -15,4 +15,7 @@ namespace pine::tool {
 int run(const char* name, CLI::App& app, int argc, char** argv,
         const std::function<int()>& body);
 
+/// The process's peak resident memory so far, in MiB (for the tools' summary lines).
+double peakMemoryMiB();
+
 }  // namespace pine::tool

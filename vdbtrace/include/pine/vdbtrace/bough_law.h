@@ -38,7 +38,7 @@ public:
                                const Vec3& V, const std::vector<Vec3>& towardsLights) const = 0;
 };
 
-/// The law registered as `name`; throws std::invalid_argument naming the registered ones.
+/// The law registered as `name`; throws InputError naming the registered ones.
 const BoughLaw& boughLaw(const std::string& name);
 /// The registered names, in registration order (the first is the default).
 std::vector<std::string> boughLawNames();

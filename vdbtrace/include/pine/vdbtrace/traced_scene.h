@@ -103,7 +103,7 @@ struct TracedSceneOptions {
 };
 
 /// Grows every tree and prepares the scene for its camera, in parallel. Keeps a pointer to
-/// `scene`, which must outlive the result. Throws std::invalid_argument for an unknown law.
+/// `scene`, which must outlive the result. Throws InputError for an unknown law.
 TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneOptions& options = {});
 
 }  // namespace pine::vdbtrace
