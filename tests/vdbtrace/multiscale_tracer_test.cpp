@@ -134,13 +134,14 @@ TEST(MultiscaleTracer, NeedleAndConeLevelsAgreeOnHowMuchTheFoliageCovers)
 struct SideOnBough {
     scenes::Scene scene;
     TracedScene traced;
-    SideOnBough()
+    explicit SideOnBough(const BoughLaw& law = boughLaw("linear"),
+                         const std::string& effects = R"("diffuse")")
     {
         scene = scenes::parseScene(R"({"name": "side-on bough",
   "camera": {"position": [0, -30, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 30,
              "resolution": [120, 90]},
   "lights": [{"type": "directional", "direction": [0, -1, 0.2]}],
-  "ground": {"type": "none"}, "species": {}, "trees": [], "effects": ["diffuse"]})",
+  "ground": {"type": "none"}, "species": {}, "trees": [], "effects": [)" + effects + "]}",
                                    "side-on.json");
         traced = buildTracedScene(scene);
         BoughDescription d;
@@ -149,11 +150,63 @@ struct SideOnBough {
         d.spec.needles.cone = {analytic::kPi / 8, 4.25, 0.05, 12};
         d.spec.needles.coneSpacing_cm = 0.9;
         traced.boughs.push_back(
-            makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear")));
+            makeTracedBough(d, scene.camera.position_cm, traced.lights, law));
         const TracedBough& b = traced.boughs.back();
         traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
     }
 };
+
+// A law of fixed numbers, to see where each of them goes.
+class FixedLaw final : public BoughLaw {
+public:
+    BoughShading shade(const analytic::BoughGeometry&, const Vec3&, const Vec3&,
+                       const std::vector<Vec3>& towardsLights) const override
+    {
+        ++calls;
+        BoughShading s;
+        s.alpha = {0.3, 0.2};
+        for (std::size_t i = 0; i < towardsLights.size(); ++i)
+            s.lights.push_back({{0.1, 0.05}, 0.5});
+        return s;
+    }
+    mutable int calls = 0;
+};
+
+TEST(BoughLaw, OneCallOfTheLawGivesEveryBoughLevelQuantity)
+{
+    // The view opacity, each light's transfer and the opacity seen from the light all come
+    // from the law the bough was made with, in one call: level 3 shows exactly its numbers.
+    const FixedLaw law;
+    SideOnBough s(law, R"("diffuse", "self_shadowing")");
+    EXPECT_EQ(law.calls, 1);
+    const TracedBough& b = s.traced.boughs.front();
+    EXPECT_EQ(b.alpha.front, 0.3);
+    EXPECT_EQ(b.lighting.at(0).transfer.rear, 0.05);
+    EXPECT_EQ(b.lighting.at(0).opacityFromLight, 0.5);
+    MultiscaleOptions level3;
+    level3.forceLevel = 3;
+    const RenderResult r = renderMultiscale(s.traced, level3);
+    const float* centre = r.image.pixel(r.image.width / 2, r.image.height / 2);
+    EXPECT_NEAR(centre[3], 1.0 - (1.0 - 0.3) * (1.0 - 0.2), 1e-6);
+    // With self-shadowing each half reflects the law's transfer (not its opacity), the rear
+    // seen through the front: G = (0.1 I_front + (1 - 0.3) 0.05 I_rear) a_G E_G / pi.
+    const BoughLighting& lit = b.lighting.at(0);
+    const double E = s.traced.lights.at(0).power.y, albedo = b.needleAlbedo.y;
+    const double expected =
+        (0.1 * lit.front.diffuse + 0.7 * 0.05 * lit.rear.diffuse) * albedo / analytic::kPi * E;
+    EXPECT_NEAR(centre[1], expected, 1e-6 * expected);
+}
+
+TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
+{
+    try {
+        boughLaw("quadratic");
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("linear"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(boughLawNames().front(), "linear");
+}
 
 TEST(MultiscaleTracer, ConeLevelCrossesTheTrueCones)
 {

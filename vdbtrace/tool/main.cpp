@@ -53,11 +53,11 @@ struct Loaded {
     vdbtrace::TracedScene traced;
 };
 
-std::unique_ptr<Loaded> load(const fs::path& file)
+std::unique_ptr<Loaded> load(const fs::path& file, const vdbtrace::TracedSceneOptions& options)
 {
     auto loaded = std::make_unique<Loaded>();
     loaded->scene = scenes::loadScene(file);
-    loaded->traced = vdbtrace::buildTracedScene(loaded->scene);
+    loaded->traced = vdbtrace::buildTracedScene(loaded->scene, options);
     return loaded;
 }
 
@@ -82,7 +82,8 @@ fs::path besideWith(const fs::path& image, const std::string& suffix)
 
 int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs,
-           vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles)
+           vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles,
+           const vdbtrace::TracedSceneOptions& model)
 {
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
     io::checkWritable(out);
@@ -97,7 +98,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         std::cerr << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "
                   << baked->voxelSize_cm << " cm read\n";
     }
-    const auto loaded = load(sceneFile);
+    const auto loaded = load(sceneFile, model);
     std::cerr << "vdbtrace: " << sceneFile.string() << ": "
               << describe(loaded->scene, loaded->traced) << '\n';
     settings.geometry.built = [](const vdbtrace::GeometryBuild& b) {
@@ -126,6 +127,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                                       " cone<" + std::to_string(s.render.coneLevelMax) +
                                       " (footprint / cone spacing)"},
         {"pine:units", "cm"},
+        {"pine:bough_law", model.boughLaw},
         {"pine:prep_seconds", std::to_string(result.prepSeconds)}};
     for (const auto& [key, value] : methodSettings.items()) {
         metadata.emplace_back("pine:" + key, value.dump());
@@ -301,6 +303,10 @@ int main(int argc, char** argv)
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
         ->check(CLI::IsMember({"level"}));
+    vdbtrace::TracedSceneOptions model;
+    renderCmd->add_option("--bough-law", model.boughLaw, "multiscale level 3's law")
+        ->check(CLI::IsMember(vdbtrace::boughLawNames()))
+        ->capture_default_str();
     renderCmd->add_option("--force-level", settings.multiscale.forceLevel,
                           "multiscale: shade every bough hit at level 1, 2 or 3")
         ->check(CLI::Range(0, 3));
@@ -346,7 +352,7 @@ int main(int argc, char** argv)
 
     return tool::run("vdbtrace", app, argc, argv, [&] {
         if (*renderCmd) {
-            return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles);
+            return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles, model);
         }
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
         if (*compareCmd) {
