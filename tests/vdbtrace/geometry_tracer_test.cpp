@@ -114,6 +114,7 @@ TEST(GeometryTracer, ComputesOnlyTheEffectsAskedFor)
 struct HandMade {
     scenes::Scene scene;
     TracedScene traced;
+    std::vector<bake::BoughSpec> specs;  ///< the boughs as bake voxelizes them
     HandMade(const std::string& camera, const std::string& lightDirection)
     {
         scene = scenes::parseScene(R"({"name": "hand-made", "camera": )" + camera + R"(,
@@ -136,6 +137,7 @@ struct HandMade {
         d.seed = seed;
         traced.boughs.push_back(
             makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear")));
+        specs.push_back(d.spec);
         return traced.boughs.back();
     }
 };
@@ -247,7 +249,7 @@ TEST(GeometryTracer, MatchesTheReferenceOnAThinBoughUpToTheLayersObliquity)
     GeometryOptions options;
     options.samples = 64;
     const RenderResult geometry = renderGeometry(s.traced, options);
-    const bake::TreeGrids grids = bake::bakeBoughs(boughSpecs(s.traced), referenceBake(0.1));
+    const bake::TreeGrids grids = bake::bakeBoughs(s.specs, referenceBake(0.1));
     const RenderResult reference = renderReference(s.traced, grids);
     double covered[2] = {0.0, 0.0};
     for (std::size_t i = 3; i < geometry.image.rgba.size(); i += 4) {

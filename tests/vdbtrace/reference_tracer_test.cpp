@@ -22,6 +22,7 @@ namespace {
 struct SideOn {
     scenes::Scene scene;
     TracedScene traced;
+    std::vector<bake::BoughSpec> specs;  ///< the boughs as bake voxelizes them
     explicit SideOn(int height = 60, double tilt_rad = 0.0)
     {
         scene = scenes::parseScene(R"({"name": "side-on bough",
@@ -41,6 +42,7 @@ struct SideOn {
         d.spec.needleAlbedo = Vec3(0.3);
         traced.boughs.push_back(
             makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear")));
+        specs.push_back(d.spec);
     }
 };
 
@@ -49,7 +51,7 @@ struct SideOn {
 // its opacity is 1 - exp(-mu layers) (analytic/true_cone_bough.h).
 double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
 {
-    const bake::TreeGrids grids = bake::bakeBoughs(boughSpecs(s.traced), referenceBake(voxel));
+    const bake::TreeGrids grids = bake::bakeBoughs(s.specs, referenceBake(voxel));
     ReferenceOptions options;
     options.subpixels = 1;
     const RenderResult r = renderReference(s.traced, grids, options);
@@ -97,7 +99,7 @@ TEST(ReferenceTracer, NoBoughsRendersTransparent)
 {
     SideOn s;
     s.traced.boughs.clear();
-    const bake::TreeGrids grids = bake::bakeBoughs(boughSpecs(s.traced), referenceBake(0.5));
+    const bake::TreeGrids grids = bake::bakeBoughs({}, referenceBake(0.5));
     const RenderResult r = renderReference(s.traced, grids);
     for (std::size_t i = 3; i < r.image.rgba.size(); i += 4) ASSERT_EQ(r.image.rgba[i], 0.0f);
 }

@@ -1,5 +1,7 @@
 #include "pine/vdbtrace/methods.h"
 
+#include "pine/bake/tree_boughs.h"
+
 #include <chrono>
 
 namespace pine::vdbtrace {
@@ -20,7 +22,7 @@ RenderResult reference(const TracedScene& scene, const MethodSettings& s,
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     const bake::TreeGrids grids =
-        bake::bakeBoughs(boughSpecs(scene), referenceBake(s.voxelSize_cm));
+        bake::bakeScene(scene.trees, referenceBake(s.voxelSize_cm));
     const double bakeSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     RenderResult result = renderReference(scene, grids, s.reference, options);
     result.seconds += bakeSeconds;

@@ -114,16 +114,6 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
     return b;
 }
 
-std::vector<bake::BoughSpec> boughSpecs(const TracedScene& scene)
-{
-    std::vector<bake::BoughSpec> specs;
-    specs.reserve(scene.boughs.size());
-    for (const TracedBough& b : scene.boughs) {
-        specs.push_back({b.base_cm, b.tip_cm, b.geometry, b.needleAlbedo});
-    }
-    return specs;
-}
-
 TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneOptions& options)
 {
     const BoughLaw& law = boughLaw(options.boughLaw);

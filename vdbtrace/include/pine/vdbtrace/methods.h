@@ -18,7 +18,8 @@ namespace pine::vdbtrace {
 struct MethodSettings {
     MultiscaleOptions multiscale;
     ReferenceOptions reference;
-    double voxelSize_cm = 0.25;              ///< reference: the bake's voxel, without `grids`
+    /// reference: without `grids`, the scene's trees are baked (bake::bakeScene) at this size
+    double voxelSize_cm = 0.25;
     const bake::TreeGrids* grids = nullptr;  ///< reference: grids read from files instead
     GeometryOptions geometry;
 };

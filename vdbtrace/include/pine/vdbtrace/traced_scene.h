@@ -93,10 +93,6 @@ struct TracedScene {
     }
 };
 
-/// The boughs of `scene` as bake voxelizes them: what the reference's grids are baked from,
-/// for a scene grown from trees (the same as bake::bakeScene of its trees) or made by hand.
-std::vector<bake::BoughSpec> boughSpecs(const TracedScene& scene);
-
 /// The choices of model that preparing a scene makes.
 struct TracedSceneOptions {
     std::string boughLaw = "linear";  ///< a name of boughLawNames()
