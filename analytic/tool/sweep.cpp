@@ -1,6 +1,7 @@
 #include "sweep.h"
 
 #include "pine/support/atomic_file.h"
+#include "pine/support/plot_script.h"
 
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/cone_shader.h"
@@ -15,7 +16,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <random>
@@ -231,28 +231,13 @@ nlohmann::json sweepLinearLaw(const fs::path& dir)
               {"radiance_exact", paper.radianceExact}}}};
 }
 
-fs::path plotScript()
-{
-    if (const char* env = std::getenv("PINE_PLOT_SCRIPT")) return env;
-    return fs::path(PINE_SOURCE_DIR) / "scripts" / "plot_sweep.py";
-}
-
 }  // namespace
 
 int runSweep(const SweepOptions& opt)
 {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    std::error_code ec;
-    fs::create_directories(opt.outDir, ec);
-    {  // fail before the work if the folder is not writable
-        std::ofstream probe(opt.outDir / ".write-test");
-        if (!probe) {
-            std::cerr << "analytic sweep: cannot write into " << opt.outDir << '\n';
-            return 2;
-        }
-    }
-    fs::remove(opt.outDir / ".write-test", ec);
+    io::checkWritableFolder(opt.outDir);  // before the work
 
     nlohmann::json summary;
     std::cerr << "analytic sweep: F fit\n";
@@ -265,9 +250,7 @@ int runSweep(const SweepOptions& opt)
 
     int status = 0;
     if (opt.plot) {
-        const std::string cmd = "MPLBACKEND=Agg /usr/bin/python3 '" + plotScript().string() +
-                                "' '" + opt.outDir.string() + "'";
-        if (std::system(cmd.c_str()) != 0) {
+        if (!pine::tool::runPlotScript(pine::tool::plotScript("plot_sweep.py"), opt.outDir)) {
             std::cerr << "analytic sweep: plotting failed (CSV and summary.json are written)\n";
             status = 1;
         }

@@ -13,7 +13,8 @@ struct SweepOptions {
 };
 
 /// Writes f_fit.csv, cone_fits.csv, linear_law.csv, linear_law_opacity.csv, summary.json and
-/// (with `plot`) sweep.png into outDir, each atomically. Progress on stderr. Returns an exit code.
+/// (with `plot`) sweep.png into outDir, each atomically. Progress on stderr. Returns 0, or 1 if
+/// plotting failed; throws InputError if outDir cannot be written (before any work).
 int runSweep(const SweepOptions& options);
 
 }  // namespace pine::analytic::tool

@@ -45,6 +45,13 @@ if [ -x "$bake" ]; then
     [ ! -e "$work/d.exr" ] || fail "a refused render wrote its image"
 fi
 
+# A folder name is a folder name: the plot script is started without a shell.
+odd="$work/a';touch \"$work/INJECTED\";'b"
+"$vdbtrace" compare "$src/scenes/bough.json" --quick --resolution 32x24 --out-dir "$odd" 2>"$work/err" \
+    || fail "compare into an oddly named folder: $(tail -1 "$work/err")"
+[ -s "$odd/report.md" ] || fail "compare wrote no report into $odd"
+[ ! -e "$work/INJECTED" ] || fail "a folder name ran as a shell command"
+
 "$vdbtrace" --help >/dev/null || fail "--help"
 "$vdbtrace" render --help >/dev/null || fail "render --help"
 

@@ -10,9 +10,9 @@
 // solid cylinder.
 #include "pine/vdbtrace/geometry_tracer.h"
 
+#include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/ground_hit.h"
 #include "pine/vdbtrace/needle_layout.h"
-#include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/render_driver.h"
 
 #include <embree3/rtcore.h>
@@ -301,7 +301,7 @@ private:
 };
 
 bool GeometryRayTracer::occluded(const Vec3& x, const Vec3& towards, double distance,
-                            unsigned geomID, unsigned primID)
+                                 unsigned geomID, unsigned primID)
 {
     ++mStats.shadowRays;
     RayContext ctx;

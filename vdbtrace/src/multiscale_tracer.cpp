@@ -2,8 +2,8 @@
 
 #include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/cone_crossings.h"
-#include "pine/vdbtrace/needle_layout.h"
 #include "pine/vdbtrace/effects_plan.h"
+#include "pine/vdbtrace/needle_layout.h"
 #include "pine/vdbtrace/render_driver.h"
 #include "pine/vdbtrace/surface_shading.h"
 

@@ -3,6 +3,7 @@
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/support/atomic_file.h"
+#include "pine/support/plot_script.h"
 #include "pine/support/tool_main.h"
 #include "pine/vdbtrace/compare.h"
 #include "pine/vdbtrace/geometry_tracer.h"
@@ -18,8 +19,6 @@
 #include <CLI/CLI.hpp>
 #include <tbb/task_arena.h>
 
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <chrono>
 #include <cstdio>
@@ -30,8 +29,6 @@
 #include <optional>
 #include <sstream>
 #include <thread>
-
-extern char** environ;
 
 namespace {
 
@@ -227,22 +224,10 @@ std::string machineDescription()
            std::to_string(tbb::this_task_arena::max_concurrency()) + " threads";
 }
 
-/// scripts/plot_compare.py DIR (or $PINE_PLOT_SCRIPT) under Debian's python3, started without
-/// a shell: no part of a path is ever interpreted. True if it drew error_vs_time.png.
 bool plotCompare(const fs::path& dir)
 {
-    const char* env = std::getenv("PINE_PLOT_SCRIPT");
-    const std::string script =
-        env ? env : (fs::path(PINE_SOURCE_DIR) / "scripts" / "plot_compare.py").string();
-    const std::string python = "/usr/bin/python3", folder = dir.string();
-    ::setenv("MPLBACKEND", "Agg", 1);
-    char* argv[] = {const_cast<char*>(python.c_str()), const_cast<char*>(script.c_str()),
-                    const_cast<char*>(folder.c_str()), nullptr};
-    pid_t pid;
-    if (::posix_spawn(&pid, python.c_str(), nullptr, nullptr, argv, environ) != 0) return false;
-    int status = 0;
-    if (::waitpid(pid, &status, 0) != pid) return false;
-    return WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::exists(dir / "error_vs_time.png");
+    return tool::runPlotScript(tool::plotScript("plot_compare.py"), dir) &&
+           fs::exists(dir / "error_vs_time.png");
 }
 
 int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double scale)
