@@ -84,6 +84,8 @@ struct FieldReader {
     }
 };
 
+class ReferenceRayTracer;
+
 // What every thread shares: the grids, their intersector, and the light reaching each voxel.
 class Reference final : public ShadingMethod {
 public:
@@ -147,6 +149,8 @@ public:
         return T;
     }
 
+private:
+    friend class ReferenceRayTracer;  // reads the grids and the light grids per thread
     const TracedScene& mScene;
     const bake::TreeGrids& mGrids;
     const EffectsPlan mPlan;
