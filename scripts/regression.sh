@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Image regression: what every method renders on every shipped scene, recorded before a
-# refactor and checked after it (DEVELOPERS.md: "record what the code produces ... show the
-# outputs unchanged or explain each difference as a bug fixed").
+# refactor and checked after it, so that the outputs are shown unchanged or each difference is
+# explained as a bug fixed (docs/architecture.md, "Regression").
 #
 #   bash scripts/regression.sh record DIR           renders into DIR (EXR + stats JSON per case)
 #   bash scripts/regression.sh check BASE DIR       renders into DIR, then compares with BASE:
@@ -43,8 +43,11 @@ cases=0
 for scene in "$out"/scenes/*.json; do
   name=$(basename "$scene" .json)
   while read -r tag args; do
-    "$bin" --threads 2 render "$scene" $args --out "$out/$name.$tag.exr" \
-      --stats "$out/$name.$tag.stats.json" 2>/dev/null
+    if ! "$bin" --threads 2 render "$scene" $args --out "$out/$name.$tag.exr" \
+        --stats "$out/$name.$tag.stats.json" 2>"$out/render.log"; then
+      echo "regression: $name $tag failed: $(tail -1 "$out/render.log")" >&2
+      exit 1
+    fi
     cases=$((cases + 1))
   done <<'EOF'
 ms-auto --method multiscale

@@ -180,9 +180,14 @@ TreeGrids readTreeGrids(const fs::path& path)
         }
     }
     for (int level = 1;; ++level) {
-        auto lod =
-            openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(*grids, densityLodName(level)));
-        if (!lod) break;
+        const openvdb::GridBase::Ptr grid = findGrid(*grids, densityLodName(level));
+        if (!grid) break;
+        auto lod = openvdb::gridPtrCast<openvdb::FloatGrid>(grid);
+        if (!lod) {
+            throw BakeError("'" + path.string() + "': grid '" + densityLodName(level) +
+                            "' has type " + grid->type() + ", expected " +
+                            openvdb::FloatGrid::gridType());
+        }
         out.densityPyramid.push_back(lod);
     }
     const auto scale = out.density->getMetadata<openvdb::DoubleMetadata>(kDensityScaleKey);

@@ -1,4 +1,5 @@
 // bake: voxelize a scene's trees into OpenVDB grids (one .vdb and its manifest per tree).
+#include "pine/bake/extinction_law.h"
 #include "pine/bake/tree_boughs.h"
 #include "pine/bake/tree_grids.h"
 #include "pine/scenes/scene.h"
@@ -126,6 +127,10 @@ int main(int argc, char** argv)
         cmd->add_option("--voxel-size", settings.voxelSize_cm, "Voxel size in cm")
             ->required()
             ->check(positive);
+        cmd->add_option("--extinction-law", settings.extinctionLaw,
+                        "How the field stops light (written into the file)")
+            ->check(CLI::IsMember(bake::extinctionLawNames()))
+            ->capture_default_str();
         cmd->add_option("--levels", settings.pyramidLevels,
                         "Density levels at h, 2h, 4h, ... (1: no pyramid)")
             ->default_val(settings.pyramidLevels)

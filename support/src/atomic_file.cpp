@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <new>
 #include <random>
 
 namespace pine::io {
@@ -33,8 +34,14 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
     };
     try {
         write(tmp);
+    } catch (const std::bad_alloc&) {  // not the output's fault: not the user's error
+        fs::remove(tmp, ignored);
+        throw;
     } catch (const std::exception& e) {
         throw refuse(e.what());
+    } catch (...) {
+        fs::remove(tmp, ignored);
+        throw;
     }
     std::error_code error;
     fs::rename(tmp, file, error);

@@ -6,9 +6,23 @@
 #include <tbb/global_control.h>
 
 #include <iostream>
+#include <string>
 #include <memory>
 
 namespace pine::tool {
+namespace {
+
+// What an error says, on one line: a library's message may span several.
+std::string oneLine(std::string text)
+{
+    while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+    for (char& c : text) {
+        if (c == '\n') c = ' ';
+    }
+    return text;
+}
+
+}  // namespace
 
 int run(const char* name, CLI::App& app, int argc, char** argv,
         const std::function<int()>& body)
@@ -31,10 +45,10 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
     try {
         return body();
     } catch (const InputError& e) {
-        std::cerr << name << ": " << e.what() << '\n';
+        std::cerr << name << ": " << oneLine(e.what()) << '\n';
         return 2;
     } catch (const std::exception& e) {
-        std::cerr << name << ": " << e.what() << '\n';
+        std::cerr << name << ": " << oneLine(e.what()) << '\n';
         return 1;
     }
 }

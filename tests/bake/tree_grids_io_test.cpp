@@ -301,9 +301,9 @@ TEST(TreeGridsIo, AnotherFormatVersionOrAnUnknownLawIsRefused)
         grids = in.getGrids();
         meta = in.getMetadata();
     }
-    const auto rewrite = [&](const openvdb::MetaMap& m) {
+    const auto rewrite = [&](const openvdb::MetaMap& m, const openvdb::GridPtrVec* with = nullptr) {
         openvdb::io::File out(file.string());
-        out.write(*grids, m);
+        out.write(with ? *with : *grids, m);
         out.close();
         writeMatchingManifest(file);
     };
@@ -319,6 +319,12 @@ TEST(TreeGridsIo, AnotherFormatVersionOrAnUnknownLawIsRefused)
     unknown.insertMeta("pine:extinction_law", openvdb::StringMetadata("fibre"));
     rewrite(unknown);
     expectRefused(file, "unknown extinction law 'fibre'");
+    // A pyramid level of another type is refused, not taken as the pyramid's end.
+    openvdb::GridPtrVec wrongLod = *grids;
+    wrongLod.push_back(openvdb::Vec3SGrid::create());
+    wrongLod.back()->setName("density_lod1");
+    rewrite(*meta, &wrongLod);
+    expectRefused(file, "grid 'density_lod1' has type Tree_vec3s");
     rewrite(*meta);
     EXPECT_EQ(readTreeGrids(file).extinctionLaw, "layer");
 }

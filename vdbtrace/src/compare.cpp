@@ -37,11 +37,10 @@ CompareRun runCompare(const CompareOptions& options)
     log(options.sceneFile.string() + ", " + std::to_string(scene.camera.width) + "x" +
         std::to_string(scene.camera.height));
     const CompareSettings& st = options.settings;
-    const CompareRun run = runComparison(scene, st, log);
+    CompareRun run = runComparison(scene, st, log);
 
     ReportInfo info;
     info.sceneFile = options.sceneFile;
-    info.scene = &scene;
     info.settings = st;
     info.machine = options.machine;
     info.errorScale = commonErrorScale(run.rows);
@@ -60,7 +59,7 @@ CompareRun runCompare(const CompareOptions& options)
         io::writeTextAtomically(dir / "flicker.csv", flickerCsv(flicker));
         info.flicker = &flicker;
     }
-    io::writeTextAtomically(dir / "report.md", reportMd(run, info));
+    io::writeTextAtomically(dir / "report.md", reportMd(run, scene, info));
 
     std::string summary = std::to_string(run.rows.size()) + " renders";
     if (options.flicker) summary += " and " + std::to_string(st.frames) + " dolly frames x 3";

@@ -156,11 +156,10 @@ void writeRowImages(const CompareRun& run, const std::filesystem::path& sceneFil
     }
 }
 
-std::string reportMd(const CompareRun& run, const ReportInfo& c)
+std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const ReportInfo& c)
 {
     const std::vector<CompareRow>& rows = run.rows;
     const CompareSettings& st = c.settings;
-    const scenes::Scene& scene = *c.scene;
     std::ostringstream s;
     s << "# `vdbtrace compare`: " << c.sceneFile.filename().string() << "\n\n";
     s << "- scene: `" << c.sceneFile.string() << "`, " << scene.camera.width << " x "

@@ -21,8 +21,9 @@ RenderResult reference(const TracedScene& scene, const MethodSettings& s,
     if (s.grids) return renderReference(scene, *s.grids, s.reference, options);
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    const bake::TreeGrids grids =
-        bake::bakeScene(scene.trees, referenceBake(s.voxelSize_cm));
+    bake::BakeSettings baking = referenceBake(s.voxelSize_cm);
+    baking.extinctionLaw = s.extinctionLaw;
+    const bake::TreeGrids grids = bake::bakeScene(scene.trees, baking);
     const double bakeSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     RenderResult result = renderReference(scene, grids, s.reference, options);
     result.seconds += bakeSeconds;

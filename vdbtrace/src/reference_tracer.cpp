@@ -77,9 +77,10 @@ struct FieldReader {
     {
         float A;
         if (!opacity.probeValue(ijk, A) || !(A > 0.0f)) return 0.0;
-        bake::LayerSample field;
+        bake::LayerSample field;  // all of it: a law may read any field
         field.layerOpacity = A;
         field.gradient = toGlm(gradient.getValue(ijk));
+        field.needle = toGlm(needle.getValue(ijk));
         return law.extinction(field, d);
     }
 };

@@ -1,4 +1,5 @@
 // vdbtrace: render a scene with the multiscale cone tracer, benchmark it, or compare methods.
+#include "pine/bake/extinction_law.h"
 #include "pine/bake/tree_boughs.h"
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
@@ -124,8 +125,8 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                                       " cone<" + std::to_string(s.render.coneLevelMax) +
                                       " (footprint / cone spacing)"},
         {"pine:units", "cm"},
-        {"pine:bough_law", model.boughLaw},
         {"pine:prep_seconds", std::to_string(result.prepSeconds)}};
+    if (methodName == "multiscale") metadata.emplace_back("pine:bough_law", model.boughLaw);
     for (const auto& [key, value] : methodSettings.items()) {
         metadata.emplace_back("pine:" + key, value.dump());
     }
@@ -274,6 +275,11 @@ int main(int argc, char** argv)
     renderCmd->add_option("--voxel-size", settings.voxelSize_cm,
                           "reference: voxel size of the baked boughs, cm")
         ->check(CLI::PositiveNumber);
+    renderCmd->add_option("--extinction-law", settings.extinctionLaw,
+                          "reference: the law of the bake (without --grids, whose files name "
+                          "theirs)")
+        ->check(CLI::IsMember(bake::extinctionLawNames()))
+        ->capture_default_str();
     renderCmd->add_option("--grids", gridFiles,
                           "reference: baked .vdb files (bake tree/scene) instead of baking now")
         ->check(CLI::ExistingFile);

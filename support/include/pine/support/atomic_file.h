@@ -17,7 +17,8 @@ std::filesystem::path temporaryBeside(const std::filesystem::path& file);
 /// Writes `file` by calling write(temporary) on a temporary beside it, then renaming the
 /// temporary onto `file`. If write throws or the rename fails, the temporary is removed and
 /// `file` is left as it was; throws InputError "cannot write 'FILE': WHY" (WHY from what the
-/// callback threw).
+/// callback threw), except for std::bad_alloc and non-standard exceptions, rethrown as they
+/// are.
 void writeAtomically(const std::filesystem::path& file,
                      const std::function<void(const std::filesystem::path& temporary)>& write);
 

@@ -13,7 +13,6 @@ namespace pine::vdbtrace {
 /// What the report says besides the rows.
 struct ReportInfo {
     std::filesystem::path sceneFile;
-    const scenes::Scene* scene = nullptr;  ///< as rendered (its resolution)
     CompareSettings settings;
     std::string machine;              ///< CPU, cores and threads, as the tool found them
     double errorScale = 1.0;          ///< luminance error shown white in every error map
@@ -24,7 +23,8 @@ struct ReportInfo {
 /// One row a render: method, setting, seconds, errors (overall and by level), prep seconds.
 std::string reportCsv(const std::vector<CompareRow>& rows);
 std::string flickerCsv(const DollyFlicker& flicker);
-std::string reportMd(const CompareRun& run, const ReportInfo& info);
+/// `scene` as rendered (its resolution).
+std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const ReportInfo& info);
 
 /// The error maps' common scale: the 99th percentile of every pixel's error over all renders
 /// but the truth, so one outlier does not darken every map and equal colours mean equal error.

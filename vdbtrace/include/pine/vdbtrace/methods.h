@@ -20,6 +20,7 @@ struct MethodSettings {
     ReferenceOptions reference;
     /// reference: without `grids`, the scene's trees are baked (bake::bakeScene) at this size
     double voxelSize_cm = 0.25;
+    std::string extinctionLaw = "layer";     ///< reference: the law of that bake
     const bake::TreeGrids* grids = nullptr;  ///< reference: grids read from files instead
     GeometryOptions geometry;
 };

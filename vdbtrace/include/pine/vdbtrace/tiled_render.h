@@ -1,4 +1,5 @@
-// The loop every tracer shares: tiles rendered in parallel, their stats summed, progress told.
+// Tiles rendered in parallel, their stats summed, progress told: the render driver's loop
+// (render_driver.cpp).
 #pragma once
 
 #include "pine/vdbtrace/render_stats.h"
