@@ -1,7 +1,6 @@
 #include "pine/vdbtrace/compare_report.h"
 
 #include "pine/vdbtrace/preview.h"
-#include "pine/vdbtrace/render_stats.h"
 
 #include <algorithm>
 #include <cmath>

@@ -11,13 +11,13 @@ namespace {
 CompareRow render(const TracedScene& traced, const std::string& method, std::string label,
                   std::string setting, const MethodSettings& settings)
 {
-    const RenderResult r = renderMethod(method).render(traced, settings, {});
+    RenderResult r = renderMethod(method).render(traced, settings, {});
     CompareRow row;
     row.method = std::move(label);
     row.setting = std::move(setting);
     row.seconds = r.seconds;
     if (method != "multiscale") row.prepSeconds = r.prepSeconds;
-    row.image = r.image;
+    row.image = std::move(r.image);
     return row;
 }
 

@@ -5,17 +5,19 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <vector>
 
 namespace pine::vdbtrace {
 namespace {
 
-// The AOV planes of kAovNames, looked up once per render, not per pixel.
+// The AOV planes of kAovNames, in its order, created and looked up once per render.
 struct Aovs {
+    static_assert(std::size(kAovNames) == 5, "one plane per name of kAovNames");
     explicit Aovs(Image& image)
-        : level(image.aov("level").data()), depth(image.aov("depth").data()),
-          diffuse(image.aov("diffuse").data()), specular(image.aov("specular").data()),
-          foliage(image.aov("foliage").data())
+        : level(image.aov(kAovNames[0]).data()), depth(image.aov(kAovNames[1]).data()),
+          diffuse(image.aov(kAovNames[2]).data()), specular(image.aov(kAovNames[3]).data()),
+          foliage(image.aov(kAovNames[4]).data())
     {
     }
     float *level, *depth, *diffuse, *specular, *foliage;
@@ -97,7 +99,6 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
     RenderResult result;
     result.image = Image(camera.width(), camera.height());
     Image& image = result.image;
-    for (const char* name : kAovNames) image.aov(name);
     const Aovs aovs(image);
     const int samples = std::max(1, method.samplesPerPixel());
 

@@ -5,6 +5,7 @@
 
 #include "pine/vdbtrace/geometry.h"
 
+#include <algorithm>
 #include <limits>
 
 namespace pine::vdbtrace {
