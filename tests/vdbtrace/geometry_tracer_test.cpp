@@ -136,7 +136,8 @@ struct HandMade {
         d.exponent = 200.0;
         d.seed = seed;
         traced.boughs.push_back(
-            makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear")));
+            makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear"),
+                            *traced.layers));
         specs.push_back(d.spec);
         return traced.boughs.back();
     }

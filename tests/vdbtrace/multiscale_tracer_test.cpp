@@ -4,6 +4,7 @@
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/cone_shader.h"
 #include "pine/vdbtrace/cone_camera.h"
+#include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -150,7 +151,7 @@ struct SideOnBough {
         d.spec.needles.cone = {analytic::kPi / 8, 4.25, 0.05, 12};
         d.spec.needles.coneSpacing_cm = 0.9;
         traced.boughs.push_back(
-            makeTracedBough(d, scene.camera.position_cm, traced.lights, law));
+            makeTracedBough(d, scene.camera.position_cm, traced.lights, law, *traced.layers));
         const TracedBough& b = traced.boughs.back();
         traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
     }
@@ -159,14 +160,16 @@ struct SideOnBough {
 // A law of fixed numbers, to see where each of them goes.
 class FixedLaw final : public BoughLaw {
 public:
-    BoughShading shade(const analytic::BoughGeometry&, const Vec3&, const Vec3&,
-                       const std::vector<Vec3>& towardsLights) const override
+    BoughShading shade(const TracedBough&, const Vec3&, const std::vector<Vec3>& towardsLights,
+                       const LayerModel&, const BoughLawNeeds&) const override
     {
         ++calls;
         BoughShading s;
-        s.alpha = {0.3, 0.2};
-        for (std::size_t i = 0; i < towardsLights.size(); ++i)
-            s.lights.push_back({{0.1, 0.05}, 0.5});
+        s.alpha = {StripProfile::constant(0.3), StripProfile::constant(0.2)};
+        for (std::size_t i = 0; i < towardsLights.size(); ++i) {
+            s.lights.push_back({{StripProfile::constant(0.1), StripProfile::constant(0.05)},
+                                StripProfile::constant(0.5)});
+        }
         return s;
     }
     mutable int calls = 0;
@@ -180,9 +183,9 @@ TEST(BoughLaw, OneCallOfTheLawGivesEveryBoughLevelQuantity)
     SideOnBough s(law, R"("diffuse", "self_shadowing")");
     EXPECT_EQ(law.calls, 1);
     const TracedBough& b = s.traced.boughs.front();
-    EXPECT_EQ(b.alpha.front, 0.3);
-    EXPECT_EQ(b.lighting.at(0).transfer.rear, 0.05);
-    EXPECT_EQ(b.lighting.at(0).opacityFromLight, 0.5);
+    EXPECT_EQ(b.alpha.front.mean(), 0.3);
+    EXPECT_EQ(b.lighting.at(0).transfer.rear.mean(), 0.05);
+    EXPECT_EQ(b.lighting.at(0).opacityFromLight.mean(), 0.5);
     MultiscaleOptions level3;
     level3.forceLevel = 3;
     const RenderResult r = renderMultiscale(s.traced, level3);
@@ -255,7 +258,7 @@ TEST(MultiscaleTracer, BoughLevelCompositesSection66sHalves)
     options.forceLevel = 3;
     const RenderResult r = renderMultiscale(s.traced, options);
     const TracedBough& b = s.traced.boughs.front();
-    const double expected = 1.0 - (1.0 - b.alpha.front) * (1.0 - b.alpha.rear);
+    const double expected = 1.0 - (1.0 - b.alpha.front.mean()) * (1.0 - b.alpha.rear.mean());
     const float centre = r.image.pixel(r.image.width / 2, r.image.height / 2)[3];
     EXPECT_NEAR(centre, expected, 1e-6);
 }

@@ -41,7 +41,8 @@ struct SideOn {
         d.spec.needles.coneSpacing_cm = 0.9;
         d.spec.needleAlbedo = Vec3(0.3);
         traced.boughs.push_back(
-            makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear")));
+            makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear"),
+                            *traced.layers));
         specs.push_back(d.spec);
     }
 };

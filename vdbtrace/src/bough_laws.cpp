@@ -6,6 +6,7 @@
 
 namespace pine::vdbtrace {
 
+std::unique_ptr<BoughLaw> makeExactBoughLaw();
 std::unique_ptr<BoughLaw> makeLinearBoughLaw();
 
 namespace {
@@ -14,7 +15,8 @@ const Registry<BoughLaw>& registry()
 {
     static const Registry<BoughLaw> laws = [] {
         Registry<BoughLaw> r("bough law");
-        r.add("linear", makeLinearBoughLaw());  // section 6.6, clamped (the default)
+        r.add("exact", makeExactBoughLaw());    // the layers crossed, chord by chord (faithful)
+        r.add("linear", makeLinearBoughLaw());  // section 6.6, clamped (the paper's)
         return r;
     }();
     return laws;

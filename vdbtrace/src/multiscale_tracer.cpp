@@ -3,6 +3,7 @@
 #include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/effects_plan.h"
+#include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/needle_layout.h"
 #include "pine/vdbtrace/render_driver.h"
 #include "pine/vdbtrace/surface_shading.h"
@@ -41,11 +42,11 @@ private:
     void addBough(const ConeRay& ray, std::size_t index);
     void addCrossings(const ConeRay& ray, std::size_t index, const TracedBough& b, double tIn,
                       double tOut, double coverage, Level level);
-    // Layers of a bough's own cones crossed from x towards the light (section 6's
-    // self-shadowing at levels 1-2, counted, not approximated): (1 - A)^count.
-    double selfShadow(const TracedBough& b, const Vec3& x, const Vec3& towardsLight);
-    void shadeNeedle(const TracedBough& b, const Vec3& needle, const Vec3& x, const Vec3& V,
-                     double alpha, double t, int level, const std::vector<Incident>& light);
+    // A needle of cone `cone` at x, its light through the bough's other layers under the
+    // layer model (section 6's self-shadowing at levels 1-2, counted, not approximated).
+    void shadeNeedle(const TracedBough& b, long cone, const Vec3& needle, const Vec3& x,
+                     const Vec3& V, double alpha, double t, int level,
+                     const std::vector<Incident>& light);
 
     const TracedScene& mScene;
     const EffectsPlan& mPlan;
@@ -56,28 +57,17 @@ private:
     std::vector<Fragment> mFragments;
 };
 
-double MultiscaleRayTracer::selfShadow(const TracedBough& b, const Vec3& x,
-                                       const Vec3& towardsLight)
-{
-    ++mStats.selfShadowEvaluations;
-    double tIn, tOut;
-    if (!intersectCylinder(ConeRay{x, towardsLight, 0.0}, b.base_cm, b.conesEnd_cm, b.radius_cm,
-                           tIn, tOut)) {
-        return 1.0;
-    }
-    int count = 0;
-    forEachConeCrossing(b, x, towardsLight, std::max(tIn, 1e-6), tOut,
-                        [&count](long, double) { ++count; });
-    return std::pow(1.0 - b.layerOpacity, count);
-}
-
-void MultiscaleRayTracer::shadeNeedle(const TracedBough& b, const Vec3& needle, const Vec3& x,
-                                      const Vec3& V, double alpha, double t, int level,
-                                      const std::vector<Incident>& light)
+void MultiscaleRayTracer::shadeNeedle(const TracedBough& b, long cone, const Vec3& needle,
+                                      const Vec3& x, const Vec3& V, double alpha, double t,
+                                      int level, const std::vector<Incident>& light)
 {
     Fragment f{t, alpha, Vec3(0.0), Vec3(0.0), level, true};
     for (const Incident& l : light) {
-        const double self = mPlan.selfShadowing ? selfShadow(b, x, l.towards) : 1.0;
+        double self = 1.0;
+        if (mPlan.selfShadowing) {
+            ++mStats.selfShadowEvaluations;
+            self = mScene.layers->transmittance(b, x, l.towards, cone);
+        }
         const Vec3 E = l.irradiance * self;
         if (mPlan.diffuse) {
             f.diffuse +=
@@ -109,18 +99,25 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
     const int needles = layout.needlesPerCone();
     const double r = layout.radius(), l = layout.length();
 
+    if (level == Level::Cone) {
+        // Level 2: each layer as the layer model stops the ray, shaded as its needle there.
+        mScene.layers->layers(b, ray.origin, ray.direction, tIn, tOut, [&](const LayerHit& hit) {
+            double rho;
+            Vec3 radial;
+            coneHeight(b, cotPhi, ray.origin + hit.t * ray.direction, &rho, &radial);
+            if (!(rho > 1e-9)) return;
+            ++mStats.coneHits;
+            const Vec3 needle = cosPhi * b.axis + sinPhi * radial;
+            shadeNeedle(b, hit.cone, needle, ray.origin + hit.t * ray.direction, V,
+                        coverage * hit.opacity, hit.t, 2, light);
+        });
+        return;
+    }
     forEachConeCrossing(b, ray.origin, ray.direction, tIn, tOut, [&](long j, double tc) {
         double rho;
         Vec3 radial;
         coneHeight(b, cotPhi, ray.origin + tc * ray.direction, &rho, &radial);
         if (!(rho > 1e-9)) return;
-        if (level == Level::Cone) {
-            ++mStats.coneHits;
-            const Vec3 needle = cosPhi * b.axis + sinPhi * radial;
-            shadeNeedle(b, needle, ray.origin + tc * ray.direction, V, coverage * b.layerOpacity,
-                        tc, 2, light);
-            return;
-        }
         // Level 1: the cone's needles nearest the crossing's azimuth, as cylinders.
         const double theta = std::atan2(glm::dot(radial, e2), glm::dot(radial, e1));
         const long nearest = std::lround((theta - layout.roll(j)) * needles / (2 * kPi));
@@ -136,7 +133,7 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
             const double c = stripCoverage(p.gap, r, ray.width(p.t));
             if (c <= 0.0) continue;
             ++mStats.needleHits;
-            shadeNeedle(b, needle, ray.origin + p.t * ray.direction, V, c, p.t, 1, light);
+            shadeNeedle(b, j, needle, ray.origin + p.t * ray.direction, V, c, p.t, 1, light);
         }
     });
 }
@@ -150,6 +147,9 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     const double w = ray.width(p.t);
     const double c = stripCoverage(p.gap, b.radius_cm, w);
     if (c <= 0.0) return;
+    // The chord's signed offset from the axis, across the strip (bough_law.h).
+    const double xi =
+        std::copysign(p.gap, glm::dot(ray.origin + p.t * ray.direction - b.base_cm, b.across));
     const Level level = mForceLevel ? Level(mForceLevel)
                                     : chooseLevel(w, b.geometry.coneSpacing_cm, mSettings);
     double tIn, tOut;
@@ -165,28 +165,38 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     if (!closestPassage(ray, b.base_cm, b.tip_cm, p)) return;
     if (!intersectCylinder(ray, b.base_cm, b.tip_cm, b.radius_cm, tIn, tOut)) tIn = tOut = p.t;
 
-    // Level 3: section 6.6 per light under the bough law, front half at the entry and rear
-    // half at the middle, so that the branch inside sorts between them.
+    // Level 3: section 6 per light under the bough law, front half at the entry and rear
+    // half at the middle, so that the branch inside sorts between them. Each profile is read
+    // over the footprint at the chord's signed offset from the axis.
     ++mStats.boughHits;
-    const std::vector<Incident>& light =
-        mSurfaces.lightAt(ray.origin + p.t * ray.direction, w, index);
-    Fragment front{tIn, c * b.alpha.front, Vec3(0.0), Vec3(0.0), 3, true};
-    Fragment rear{0.5 * (tIn + tOut), c * b.alpha.rear, Vec3(0.0), Vec3(0.0), 3, true};
+    const Vec3 passage = ray.origin + p.t * ray.direction;
+    const double R = b.radius_cm;
+    const double frontAlpha = b.alpha.front.overFootprint(xi, R, w);
+    // What the rear's share is divided by to composite behind the front (bough_law.h).
+    const double behindFront =
+        b.rearComposite == RearComposite::Share ? 1.0 - frontAlpha : 1.0;
+    const auto rearPart = [&](const StripProfile& profile) {
+        return behindFront > 1e-9 ? profile.overFootprint(xi, R, w) / behindFront : 0.0;
+    };
+    const std::vector<Incident>& light = mSurfaces.lightAt(passage, w, index);
+    Fragment front{tIn, frontAlpha, Vec3(0.0), Vec3(0.0), 3, true};
+    Fragment rear{0.5 * (tIn + tOut), rearPart(b.alpha.rear), Vec3(0.0), Vec3(0.0), 3, true};
     for (std::size_t i = 0; i < light.size(); ++i) {
         const BoughLighting& lit = b.lighting[i];
         const Vec3& E = light[i].irradiance;
         // Without self-shadowing the whole opacity reflects; with it, the law's transfer.
-        const double tf = mPlan.selfShadowing ? lit.transfer.front : b.alpha.front;
-        const double tr = mPlan.selfShadowing ? lit.transfer.rear : b.alpha.rear;
+        const FrontRearProfile& transfer = mPlan.selfShadowing ? lit.transfer : b.alpha;
+        const double tf = transfer.front.overFootprint(xi, R, w);
+        const double tr = rearPart(transfer.rear);
         mStats.selfShadowEvaluations += mPlan.selfShadowing ? 2 : 0;
         if (mPlan.diffuse) {
-            front.diffuse += c * tf * lit.front.diffuse * b.needleAlbedo / kPi * E;
-            rear.diffuse += c * tr * lit.rear.diffuse * b.needleAlbedo / kPi * E;
+            front.diffuse += tf * lit.front.diffuse * b.needleAlbedo / kPi * E;
+            rear.diffuse += tr * lit.rear.diffuse * b.needleAlbedo / kPi * E;
             mStats.diffuseEvaluations += 2;
         }
         if (mPlan.specular) {
-            front.specular += c * tf * lit.front.specular * b.specularWeight * E;
-            rear.specular += c * tr * lit.rear.specular * b.specularWeight * E;
+            front.specular += tf * lit.front.specular * b.specularWeight * E;
+            rear.specular += tr * lit.rear.specular * b.specularWeight * E;
             mStats.specularEvaluations += 2;
         }
     }

@@ -28,8 +28,8 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         } else {
             const TracedBough& b = scene.bough(index);
             if (closestPassage(ray, b.base_cm, b.tip_cm, p) && p.t < tMax) {
-                const double c = stripCoverage(p.gap, b.radius_cm, ray.width(p.t));
-                transmittance *= 1.0 - c * b.lighting[light].opacityFromLight;
+                transmittance *= 1.0 - b.lighting[light].opacityFromLight.overFootprint(
+                                           p.gap, b.radius_cm, ray.width(p.t));
             }
         }
     });

@@ -3,6 +3,9 @@
 #include "pine/analytic/cone_shader.h"
 #include "pine/bake/tree_boughs.h"
 #include "pine/scenes/colours.h"
+#include "pine/analytic/direction.h"
+#include "pine/vdbtrace/effects_plan.h"
+#include "pine/vdbtrace/layer_model.h"
 
 #include <glm/geometric.hpp>
 #include <tbb/parallel_for.h>
@@ -69,8 +72,16 @@ ConeRay Light::shadowCone(const Vec3& x, double footprint_cm, double& tMax) cons
     return ray;
 }
 
+Vec3 stripAcross(const Vec3& axis, const Vec3& towards)
+{
+    const Vec3 c = glm::cross(axis, towards);
+    const double n = glm::length(c);
+    return n > 1e-9 ? c / n : analytic::anyPerpendicular(axis);
+}
+
 TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
-                            const std::vector<Light>& lights, const BoughLaw& law)
+                            const std::vector<Light>& lights, const BoughLaw& law,
+                            const LayerModel& layers, const BoughLawNeeds& needs)
 {
     TracedBough b;
     b.base_cm = d.spec.base_cm;
@@ -98,8 +109,10 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
         light.at(centre, L, distance, irradiance);
         towards.push_back(L);
     }
-    const BoughShading shading = law.shade(b.geometry, b.axis, V, towards);
+    b.across = stripAcross(b.axis, V);
+    const BoughShading shading = law.shade(b, V, towards, layers, needs);
     b.alpha = shading.alpha;
+    b.rearComposite = shading.rear;
     for (std::size_t i = 0; i < lights.size(); ++i) {
         const auto sums = analytic::coneSums(
             cone, analytic::coneIntegrals(cone.aperture_rad, b.axis, towards[i], V, b.exponent),
@@ -117,8 +130,12 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
 TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneOptions& options)
 {
     const BoughLaw& law = boughLaw(options.boughLaw);
+    const LayerModel& layers = layerModel(options.layerModel);
+    const EffectsPlan plan = EffectsPlan::from(scene.effects);
+    const BoughLawNeeds needs{plan.selfShadowing, plan.shadowRays};
     TracedScene out;
     out.scene = &scene;
+    out.layers = &layers;
     out.lights = unifiedLights(scene);
     out.trees.resize(scene.trees.size());
     tbb::parallel_for(std::size_t(0), scene.trees.size(), [&](std::size_t i) {
@@ -146,7 +163,8 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneOption
     }
     out.boughs.resize(boughs.size());
     tbb::parallel_for(std::size_t(0), boughs.size(), [&](std::size_t k) {
-        out.boughs[k] = makeTracedBough(boughs[k], scene.camera.position_cm, out.lights, law);
+        out.boughs[k] = makeTracedBough(boughs[k], scene.camera.position_cm, out.lights, law,
+                                       layers, needs);
     });
 
     std::vector<Aabb> boxes;

@@ -1,11 +1,13 @@
 // Level 3's law: how a bough, shaded as a volume (paper section 6), covers the pixel and passes
 // light. A law is a type registered by name in src/bough_laws.cpp and chosen once per render
 // (TracedSceneOptions::boughLaw): the view opacity, each light's transfer and each light's
-// opacity all come from the same law, in one call, so that no render mixes two laws.
+// opacity all come from the same law, in one call, so that no render mixes two laws. Each is a
+// profile across the bough's strip (strip_profile.h): the paper's laws are one value for the
+// whole strip, the exact law a function of the chord's offset.
 #pragma once
 
-#include "pine/analytic/bough_shader.h"
 #include "pine/vdbtrace/geometry.h"
+#include "pine/vdbtrace/strip_profile.h"
 
 #include <memory>
 #include <string>
@@ -13,29 +15,54 @@
 
 namespace pine::vdbtrace {
 
+struct TracedBough;
+class LayerModel;
+
+/// How the rear half's profiles composite behind the front's.
+enum class RearComposite {
+    /// The rear profiles are its own opacity and radiance, composited as they are behind the
+    /// front (the paper's section 6.6 alphas).
+    Own,
+    /// The rear profiles are its share of the strip's coverage and radiance as seen through the
+    /// front: composited divided by what the front leaves, so that front and rear together
+    /// give the strip's coverage at any pixel coverage.
+    Share,
+};
+
 /// A bough as one light sees it, under a law.
 struct BoughLightTransfer {
-    /// Radiance of each half per unit I^cyl of its face and unit opacity-weighted irradiance,
-    /// with the bough's self-shadowing (section 6.6's I_FV / I^cyl and I_RV / I^cyl).
-    analytic::FrontRear transfer;
-    /// The whole bough's opacity seen from the light: what its shadow takes from light
-    /// crossing it.
-    double opacityFromLight = 0.0;
+    /// Radiance of each half per unit I^cyl of its face and unit irradiance, with the
+    /// bough's self-shadowing (section 6.6's I_FV / I^cyl and I_RV / I^cyl), across the
+    /// view's strip.
+    FrontRearProfile transfer;
+    /// The whole bough's opacity seen from the light, across the light's strip: what its
+    /// shadow takes from light crossing it.
+    StripProfile opacityFromLight;
+};
+
+/// What a render needs of a bough law: a law may skip what is not needed.
+struct BoughLawNeeds {
+    bool transfer = true;        ///< self-shadowing: each light's transfer
+    bool shadowOpacity = true;   ///< shadows: each light's opacity
 };
 
 /// A bough under a law, for one camera position and the scene's lights.
 struct BoughShading {
-    analytic::FrontRear alpha;               ///< opacity of each half seen from the camera
+    FrontRearProfile alpha;  ///< opacity of each half seen from the camera, across its strip
+    RearComposite rear = RearComposite::Own;
     std::vector<BoughLightTransfer> lights;  ///< one per light, in the scene's order
 };
 
 class BoughLaw {
 public:
     virtual ~BoughLaw() = default;
-    /// The bough `geometry` around unit `axis`, seen along unit V (towards the camera) and lit
-    /// along each unit direction of `towardsLights`.
-    virtual BoughShading shade(const analytic::BoughGeometry& geometry, const Vec3& axis,
-                               const Vec3& V, const std::vector<Vec3>& towardsLights) const = 0;
+    /// Bough b (its frame, geometry, R and A set), seen along unit V (towards the camera),
+    /// its strip's offsets measured along b.across, and lit along each unit direction of
+    /// `towardsLights`, whose strips' offsets are along normalize(b.axis x L). `layers` is the
+    /// render's layer model, for a law that crosses the layers.
+    virtual BoughShading shade(const TracedBough& b, const Vec3& V,
+                               const std::vector<Vec3>& towardsLights, const LayerModel& layers,
+                               const BoughLawNeeds& needs) const = 0;
 };
 
 /// The law registered as `name`; throws InputError naming the registered ones.

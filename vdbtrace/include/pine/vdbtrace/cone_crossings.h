@@ -52,4 +52,87 @@ void forEachConeCrossing(const TracedBough& b, const Vec3& o, const Vec3& d, dou
     }
 }
 
+/// Where a line passes cone j's needles (the fibre layer model, errata E13): one band is the
+/// part of the line nearer cone j than any other (|g - j dh| < dh / 2) on one monotone piece of
+/// g, so that a line crossing a cone twice meets its needles twice, at two azimuths, and a line
+/// tangent to a cone meets them once, over the finite length the curvature allows.
+struct ConeBand {
+    long cone = 0;
+    double t = 0.0;        ///< the needle-weighted mean of t over the band
+    double needles = 0.0;  ///< expected number of cone j's needles the line hits there
+};
+
+/// Calls visit(band) -> bool (false stops) for every band of cones 0 .. floor(length / dh)
+/// along o + t d (d unit), t in [tIn, tOut], in order. `needles` integrates
+/// sigma = (needle length per volume) 2 r |d x a| along the band: thin needles placed
+/// independently. Needles fan out from the axis, so their length per volume is
+/// N / (2 pi rho dh sin(phi)) and their coverage of their cone N r / (pi rho), capped at 1
+/// where they overlap near the apex; its mean over the cone is the paper's A = 2 N r / (pi R).
+/// The same march as forEachConeCrossing; each step's needles are split between the bands it
+/// spans in proportion to g.
+template <class Visit>
+void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn, double tOut,
+                     Visit&& visit)
+{
+    const analytic::ConeGeometry& cone = b.geometry.cone;
+    const double dh = b.geometry.coneSpacing_cm;
+    const double sinPhi = std::sin(cone.aperture_rad), cosPhi = std::cos(cone.aperture_rad);
+    const double cotPhi = cosPhi / sinPhi;
+    const long jMax = long(std::floor(b.length_cm / dh));
+    const double dt = dh / (4.0 * (1.0 + cotPhi));
+    const double coverageTimesRho = cone.needlesPerCone * cone.needleRadius_cm / analytic::kPi;
+    const double layersPerCm = 1.0 / (dh * sinPhi);  // |grad g| / dh
+    // g and sigma at o + t d.
+    const auto at = [&](double t, double& g, double& sigma) {
+        double rho;
+        Vec3 radial;
+        g = coneHeight(b, cotPhi, o + t * d, &rho, &radial);
+        const Vec3 needle = rho > 0.0 ? cosPhi * b.axis + sinPhi * radial : b.axis;
+        const double coverage = rho > coverageTimesRho ? coverageTimesRho / rho : 1.0;
+        sigma = coverage * glm::length(glm::cross(d, needle)) * layersPerCm;
+    };
+    const auto bandOf = [&](double g) { return long(std::floor(g / dh + 0.5)); };
+
+    double t0 = tIn, g0, s0;
+    at(t0, g0, s0);
+    long band = bandOf(g0);
+    double needles = 0.0, weightedT = 0.0;
+    int direction = 0;
+    // Ends the current band; false when the visitor wants no more.
+    const auto finish = [&]() {
+        bool more = true;
+        if (needles > 0.0 && band >= 0 && band <= jMax) {
+            more = visit(ConeBand{band, weightedT / needles, needles});
+        }
+        needles = weightedT = 0.0;
+        return more;
+    };
+    int steps = 0;
+    while (t0 < tOut && steps++ < 100000) {
+        const double t1 = std::min(t0 + dt, tOut);
+        double g1, s1;
+        at(t1, g1, s1);
+        const int stepDirection = g1 > g0 ? 1 : (g1 < g0 ? -1 : direction);
+        if (direction != 0 && stepDirection != direction && !finish()) return;  // g turned
+        direction = stepDirection;
+        const double count = 0.5 * (s0 + s1) * (t1 - t0);
+        double done = 0.0;  // fraction of the step already given to a band
+        while (bandOf(g1) != band && direction != 0) {
+            const double boundary = (double(band) + 0.5 * direction) * dh;
+            const double f = std::clamp((boundary - g0) / (g1 - g0), done, 1.0);
+            needles += (f - done) * count;
+            weightedT += (f - done) * count * (t0 + 0.5 * (done + f) * (t1 - t0));
+            if (!finish()) return;
+            band += direction;
+            done = f;
+        }
+        needles += (1.0 - done) * count;
+        weightedT += (1.0 - done) * count * (t0 + 0.5 * (done + 1.0) * (t1 - t0));
+        t0 = t1;
+        g0 = g1;
+        s0 = s1;
+    }
+    finish();
+}
+
 }  // namespace pine::vdbtrace

@@ -11,12 +11,15 @@
 #include "pine/scenes/tree.h"
 #include "pine/vdbtrace/bough_law.h"
 #include "pine/vdbtrace/bvh.h"
+#include "pine/vdbtrace/strip_profile.h"
 
 #include <cstddef>
 #include <string>
 #include <vector>
 
 namespace pine::vdbtrace {
+
+class LayerModel;
 
 struct Light {
     bool directional = false;
@@ -41,8 +44,8 @@ struct TracedBranch {
 /// What a bough looks like from one light with the camera where it is (section 6 inputs).
 struct BoughLighting {
     analytic::FaceReflectance front, rear;  ///< I^cyl of each face (diffuse, specular)
-    analytic::FrontRear transfer;           ///< the bough law's, with self-shadowing
-    double opacityFromLight = 0.0;          ///< the bough law's: the whole bough from the light
+    FrontRearProfile transfer;              ///< the bough law's, with self-shadowing
+    StripProfile opacityFromLight;          ///< the bough law's: the whole bough from the light
 };
 
 /// What the scene says of one bough: what makeTracedBough prepares.
@@ -66,17 +69,26 @@ struct TracedBough {
     Vec3 needleAlbedo{0.2};
     double specularWeight = 0.0;
     double exponent = 100.0;
-    analytic::FrontRear alpha;  ///< the bough law's opacity of each half seen from the camera
+    /// Unit, across the strip the bough covers seen from the camera: the sign of a chord's
+    /// offset from the axis (stripAcross(axis, V)).
+    Vec3 across{0.0};
+    FrontRearProfile alpha;  ///< the bough law's opacity of each half seen from the camera
+    RearComposite rearComposite = RearComposite::Own;  ///< how the law's rear half composites
     unsigned seed = 0;          ///< drives the needles' azimuths at level 1
     std::vector<BoughLighting> lighting;  ///< one per light
 };
 
-/// The bough of `description` prepared for a camera at `eye_cm` and `lights` under `law`: its
-/// frame, R and A, and everything that depends only on directions from its centre (the cone
-/// level's face reflectances, the law's opacities and transfers), once per bough and light.
-/// @throw std::invalid_argument for a bough of zero length.
+/// Unit, orthogonal to the unit `axis` and to `towards`: the direction across the strip a
+/// bough covers seen from `towards` (any perpendicular to the axis when they are parallel).
+Vec3 stripAcross(const Vec3& axis, const Vec3& towards);
+
+/// The bough of `description` prepared for a camera at `eye_cm` and `lights` under `law` and
+/// `layers`: its frame, R and A, and everything that depends only on directions from its
+/// centre (the cone level's face reflectances, the law's opacities and transfers), once per
+/// bough and light. @throw std::invalid_argument for a bough of zero length.
 TracedBough makeTracedBough(const BoughDescription& description, const Vec3& eye_cm,
-                            const std::vector<Light>& lights, const BoughLaw& law);
+                            const std::vector<Light>& lights, const BoughLaw& law,
+                            const LayerModel& layers, const BoughLawNeeds& needs = {});
 
 struct TracedScene {
     const scenes::Scene* scene = nullptr;
@@ -85,6 +97,7 @@ struct TracedScene {
     std::vector<TracedBranch> branches;  ///< primitive index i < branches.size()
     std::vector<TracedBough> boughs;     ///< primitive index branches.size() + j
     Bvh bvh;
+    const LayerModel* layers = nullptr;  ///< how a layer stops a line (layer_model.h)
 
     bool isBranch(std::size_t primitive) const { return primitive < branches.size(); }
     const TracedBough& bough(std::size_t primitive) const
@@ -95,11 +108,12 @@ struct TracedScene {
 
 /// The choices of model that preparing a scene makes.
 struct TracedSceneOptions {
-    std::string boughLaw = "linear";  ///< a name of boughLawNames()
+    std::string boughLaw = "linear";     ///< a name of boughLawNames()
+    std::string layerModel = "paper";    ///< a name of layerModelNames()
 };
 
 /// Grows every tree and prepares the scene for its camera, in parallel. Keeps a pointer to
-/// `scene`, which must outlive the result. Throws InputError for an unknown law.
+/// `scene`, which must outlive the result. Throws InputError for an unknown law or model.
 TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneOptions& options = {});
 
 }  // namespace pine::vdbtrace

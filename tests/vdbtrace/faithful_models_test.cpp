@@ -1,0 +1,115 @@
+// The faithful models against the explicit needles they stand for (issue: every approximation
+// a switch): one long paper bough seen side-on and at 60 and 30 degrees from its branch, each
+// level's mean strip opacity under each layer model and bough law against the geometry
+// method's needles.
+#include "pine/scenes/scene.h"
+#include "pine/vdbtrace/effects_plan.h"
+#include "pine/vdbtrace/geometry_tracer.h"
+#include "pine/vdbtrace/layer_model.h"
+#include "pine/vdbtrace/multiscale_tracer.h"
+#include "pine/vdbtrace/traced_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace pine::vdbtrace {
+namespace {
+
+constexpr double kPi = analytic::kPi;
+
+// A paper bough (N 12, r 0.05, l 4.25, phi pi/8, dh 0.9) 200 cm long through the origin, its
+// branch at `angle_deg` from the view direction, seen from 400 cm with a 9 degree field: its
+// ends lie outside the frame, so the image's total opacity is the strip's mean opacity times
+// its area, the same area for every method.
+struct LongBough {
+    scenes::Scene scene;
+    TracedScene traced;
+    LongBough(double angle_deg, const TracedSceneOptions& options, unsigned seed = 7,
+              const std::string& effects = R"("diffuse")")
+    {
+        scene = scenes::parseScene(R"({"name": "long bough",
+  "camera": {"position": [0, -400, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 9,
+             "resolution": [320, 240]},
+  "lights": [{"type": "directional", "direction": [0.3, -1, 0.6]}],
+  "ground": {"type": "none"}, "species": {}, "trees": [], "effects": [)" + effects + "]}",
+                                   "long-bough.json");
+        traced = buildTracedScene(scene, options);
+        const double a = angle_deg * kPi / 180.0;
+        const Vec3 axis(std::sin(a), std::cos(a), 0.0);
+        BoughDescription d;
+        d.spec.base_cm = -100.0 * axis;
+        d.spec.tip_cm = 100.0 * axis;
+        d.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
+        d.spec.needles.coneSpacing_cm = 0.9;
+        d.seed = seed;
+        const EffectsPlan plan = EffectsPlan::from(scene.effects);
+        traced.boughs.push_back(makeTracedBough(d, scene.camera.position_cm, traced.lights,
+                                                boughLaw(options.boughLaw),
+                                                layerModel(options.layerModel),
+                                                {plan.selfShadowing, plan.shadowRays}));
+        const TracedBough& b = traced.boughs.back();
+        traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
+    }
+};
+
+double totalOpacity(const RenderResult& r)
+{
+    double sum = 0.0;
+    for (std::size_t i = 3; i < r.image.rgba.size(); i += 4) sum += r.image.rgba[i];
+    return sum;
+}
+
+double needles(double angle_deg, unsigned seed)
+{
+    GeometryOptions g;
+    g.samples = 16;
+    return totalOpacity(renderGeometry(LongBough(angle_deg, {}, seed).traced, g));
+}
+
+double multiscale(double angle_deg, int level, const std::string& layers,
+                  const std::string& law = "exact")
+{
+    TracedSceneOptions options;
+    options.layerModel = layers;
+    options.boughLaw = law;
+    MultiscaleOptions m;
+    m.forceLevel = level;
+    return totalOpacity(renderMultiscale(LongBough(angle_deg, options).traced, m));
+}
+
+TEST(FaithfulModels, EveryLevelCoversWhatTheNeedlesCover)
+{
+    // The needles' mean over 6 rolls (each cone's roll drives where its needles point): the
+    // spread of that mean is printed and must stay under 1%, so that 3% measures the models.
+    // Under the paper's choices level 2 covers about 0.8 of the needles (errata E13) and the
+    // clamped linear law overshoots at level 3 (E11); both are printed, not asserted.
+    for (const double angle : {90.0, 60.0, 30.0}) {
+        constexpr int kRolls = 6;
+        double sum = 0.0, sum2 = 0.0;
+        for (unsigned seed = 1; seed <= kRolls; ++seed) {
+            const double x = needles(angle, seed);
+            sum += x;
+            sum2 += x * x;
+        }
+        const double truth = sum / kRolls;
+        const double spread =
+            std::sqrt(std::max(0.0, sum2 / kRolls - truth * truth) / (kRolls - 1)) / truth;
+        const double l2 = multiscale(angle, 2, "fibre") / truth;
+        const double l3 = multiscale(angle, 3, "fibre") / truth;
+        std::printf("%3.0f deg from the branch, against the needles (spread of their mean "
+                    "%.2f%%): fibre level 2 %.4f, level 3 exact %.4f; paper level 2 %.4f, "
+                    "level 3 linear %.4f\n",
+                    angle, 100.0 * spread, l2, l3, multiscale(angle, 2, "paper") / truth,
+                    multiscale(angle, 3, "paper", "linear") / truth);
+        EXPECT_LT(spread, 0.01) << angle;
+        EXPECT_NEAR(l2, 1.0, 0.03) << angle;
+        EXPECT_NEAR(l3, 1.0, 0.03) << angle;
+    }
+}
+
+}  // namespace
+}  // namespace pine::vdbtrace

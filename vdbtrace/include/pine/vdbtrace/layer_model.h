@@ -1,0 +1,41 @@
+// How much one layer of needles stops a line that crosses it (docs/errata.md E13): the choice
+// every level that sees a bough's cones as layers makes (level 2, the self-shadowing of levels
+// 1-2, and level 3's exact law). A model is a type registered by name in src/layer_models.cpp
+// and chosen once per render (TracedSceneOptions::layerModel).
+#pragma once
+
+#include "pine/vdbtrace/traced_scene.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace pine::vdbtrace {
+
+/// One layer of a bough met by a line: cone `cone`'s needles, where the line meets them.
+struct LayerHit {
+    long cone = 0;
+    double t = 0.0;        ///< along the line: where its needles are met
+    double opacity = 0.0;  ///< the probability that the line hits one of them, in [0, 1]
+};
+
+class LayerModel {
+public:
+    virtual ~LayerModel() = default;
+    /// Calls visit for every layer of b that the line o + t d (d unit) meets for t in
+    /// [tIn, tOut]; each layer's needles are independent of every other layer's (each cone has
+    /// its own roll, needle_layout.h).
+    virtual void layers(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn,
+                        double tOut, const std::function<void(const LayerHit&)>& visit) const = 0;
+    /// The light that reaches x on a needle of cone `ownCone` from unit direction
+    /// `towardsLight` through b's other layers (section 6's self-shadowing, counted).
+    virtual double transmittance(const TracedBough& b, const Vec3& x, const Vec3& towardsLight,
+                                 long ownCone) const = 0;
+};
+
+/// The model registered as `name`; throws InputError naming the registered ones.
+const LayerModel& layerModel(const std::string& name);
+/// The registered names, in registration order.
+std::vector<std::string> layerModelNames();
+
+}  // namespace pine::vdbtrace
