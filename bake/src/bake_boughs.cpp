@@ -189,6 +189,7 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
     auto gradient = out.layerGradient->getAccessor();
     auto opacity = out.layerOpacity->getAccessor();
     auto needle = out.needleDirection->getAccessor();
+    auto coverage = out.needleCoverage->getAccessor();
     auto albedo = out.needleAlbedo->getAccessor();
     double maxMean = 0.0;
     for (auto it = keys->cbeginValueOn(); it; ++it) {
@@ -205,6 +206,7 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
         gradient.setValue(ijk, vec(s->gradient));
         opacity.setValue(ijk, float(s->layerOpacity));
         needle.setValue(ijk, vec(s->needle));
+        coverage.setValue(ijk, float(s->needleCoverage));
         albedo.setValue(ijk, vec(boughs[b].needleAlbedo));
     }
 

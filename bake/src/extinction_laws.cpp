@@ -6,6 +6,7 @@
 
 namespace pine::bake {
 
+std::unique_ptr<ExtinctionLaw> makeFibreExtinctionLaw();
 std::unique_ptr<ExtinctionLaw> makeLayerExtinctionLaw();
 
 namespace {
@@ -14,7 +15,8 @@ const Registry<ExtinctionLaw>& registry()
 {
     static const Registry<ExtinctionLaw> laws = [] {
         Registry<ExtinctionLaw> r("extinction law");
-        r.add("layer", makeLayerExtinctionLaw());  // section 6's layers (the default)
+        r.add("fibre", makeFibreExtinctionLaw());  // the needles as thin fibres (faithful)
+        r.add("layer", makeLayerExtinctionLaw());  // section 6's layers (the paper's)
         return r;
     }();
     return laws;

@@ -57,6 +57,7 @@ PreparedBough::PreparedBough(const BoughSpec& spec)
     mLength = glm::length(spec.tip_cm - spec.base_cm);
     mRadius = analytic::boughRadius(cone);      // R = l sin(phi)
     mOpacity = analytic::layerOpacity(cone);    // A = 2 N r / (pi R), in [0, 1]
+    mCoverageTimesRho = cone.needlesPerCone * cone.needleRadius_cm / analytic::kPi;
     mCosPhi = std::cos(phi);
     mSinPhi = std::sin(phi);
     mCotPhi = mCosPhi / mSinPhi;
@@ -84,6 +85,7 @@ std::optional<LayerSample> PreparedBough::sample(const Vec3& x_cm) const
     s.gradient = (mAxis - mCotPhi * radial) * mInvSpacing;  // grad g / dh
     s.needle = mCosPhi * mAxis + mSinPhi * radial;
     s.layerOpacity = mOpacity;
+    s.needleCoverage = std::min(1.0, mCoverageTimesRho / rho);
     return s;
 }
 

@@ -33,6 +33,7 @@ private:
     Vec3 mBase{0.0}, mAxis{0.0, 0.0, 1.0};
     double mLength = 0.0, mRadius = 0.0, mCotPhi = 0.0, mCosPhi = 1.0, mSinPhi = 0.0;
     double mInvSpacing = 0.0, mOpacity = 0.0;
+    double mCoverageTimesRho = 0.0;  ///< N r / pi
     bool mEmpty = true;
     const char* mInvalid = nullptr;
 };

@@ -26,6 +26,7 @@ openvdb::GridBase::Ptr TreeGrids::grid(Field field) const
     case Field::LayerGradient: return layerGradient;
     case Field::LayerOpacity: return layerOpacity;
     case Field::NeedleDirection: return needleDirection;
+    case Field::NeedleCoverage: return needleCoverage;
     case Field::NeedleAlbedo: return needleAlbedo;
     }
     return nullptr;
@@ -39,6 +40,7 @@ void TreeGrids::setGrid(Field field, const openvdb::GridBase::Ptr& grid)
     case Field::LayerOpacity: return setTyped<openvdb::FloatGrid>(layerOpacity, grid, field);
     case Field::NeedleDirection:
         return setTyped<openvdb::Vec3SGrid>(needleDirection, grid, field);
+    case Field::NeedleCoverage: return setTyped<openvdb::FloatGrid>(needleCoverage, grid, field);
     case Field::NeedleAlbedo: return setTyped<openvdb::Vec3SGrid>(needleAlbedo, grid, field);
     }
 }

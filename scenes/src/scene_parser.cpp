@@ -133,6 +133,15 @@ RenderSettings readRender(const Json& value, const Where& where)
     ObjectReader r(value, where);
     RenderSettings s;
     s.background = r.colour("background", Range::atLeast(0), s.background);
+    const std::string preset = r.string("preset", "faithful");
+    if (preset == "paper") {
+        s.model = ModelChoices::paper();
+    } else if (preset != "faithful") {
+        where.key("preset").fail("must be \"faithful\" or \"paper\"");
+    }
+    s.model.boughLaw = r.string("bough_law", s.model.boughLaw);
+    s.model.layerModel = r.string("layer_model", s.model.layerModel);
+    s.model.extinctionLaw = r.string("extinction_law", s.model.extinctionLaw);
     s.needleLevelMax = r.number("needle_level_max", Range::above(0), s.needleLevelMax);
     s.coneLevelMax = r.number("cone_level_max", Range::above(0), s.coneLevelMax);
     if (!(s.coneLevelMax > s.needleLevelMax)) {

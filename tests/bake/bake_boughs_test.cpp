@@ -70,7 +70,7 @@ TEST(BakeBoughs, MassOfALongBoughMatchesTheIntegral)
             BoughSpec shifted = b;
             shifted.base_cm += shift;
             shifted.tip_cm += shift;
-            const TreeGrids g = bakeBoughs({shifted}, BakeSettings{h, 1});
+            const TreeGrids g = bakeBoughs({shifted}, BakeSettings{h, 1, "layer"});
             const double error = std::abs(voxelizedMass(g) / exact - 1.0);
             EXPECT_LT(error, bound / 10) << "h " << h << ", shift " << k;
             sumError += error;
@@ -105,6 +105,26 @@ openvdb::CoordBBox searchBox(const BoughSpec& b, double h)
     return box;
 }
 
+TEST(BakeBoughs, FibreMassIsTheNeedlesMeanProjectedArea)
+{
+    // Cauchy: a thin needle of length l and radius r shows a mean projected area (pi / 4) 2 r l
+    // over all directions, so under the fibre law sum(mean extinction x h^3) is (pi / 4) 2 r
+    // times the needles' total length, N l L / dh, less what the cap on their coverage
+    // removes near the axis: there min(1, N r / (pi rho)) = 1 for rho < rho0 = N r / pi, which
+    // takes pi rho0^2 L / (dh sin(phi)) (pi / 4) from the integral of the uncapped coverage.
+    const BoughSpec b = test::paperBough(Vec3(0.3, -0.7, 0.1), Vec3(0.3, 0.5, 0.8), 60.0);
+    const analytic::ConeGeometry& c = b.needles.cone;
+    const double L = 60.0, dh = b.needles.coneSpacing_cm, sinPhi = std::sin(c.aperture_rad);
+    const double rho0 = c.needlesPerCone * c.needleRadius_cm / kPi;
+    const double exact = 0.25 * kPi *
+                         (2.0 * c.needleRadius_cm * c.needlesPerCone * c.needleLength_cm * L / dh -
+                          kPi * rho0 * rho0 * L / (dh * sinPhi));
+    const double h = c.needleLength_cm * sinPhi / 16;
+    const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 1, "fibre"});
+    // The coverage's 1 / rho near the axis adds a little to the voxel error of the layer law.
+    EXPECT_NEAR(voxelizedMass(g) / exact, 1.0, 0.01);
+}
+
 TEST(BakeBoughs, EveryVoxelSamplesTheFieldAtItsCentre)
 {
     // Every voxel of the box around the bough: active exactly where the field exists at the
@@ -112,7 +132,7 @@ TEST(BakeBoughs, EveryVoxelSamplesTheFieldAtItsCentre)
     // voxel dropped by the voxelizer's column bounds as much as a half-voxel shift.
     const BoughSpec b = test::paperBough(Vec3(-2.1, 3.4, 0.7), Vec3(-0.6, 0.2, 0.7), 12.0);
     const double h = 0.35;
-    const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 1});
+    const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 1, "layer"});
     ASSERT_GT(g.densityScale_per_cm, 0.0);
     EXPECT_EQ(g.voxelSize_cm, h);
     const auto& xform = g.density->transform();
@@ -154,12 +174,13 @@ TEST(BakeBoughs, EveryVoxelSamplesTheFieldAtItsCentre)
 TEST(BakeBoughs, OverlapKeepsTheDensestBoughWhateverTheOrder)
 {
     // Two boughs crossing at right angles, the second denser (more needles per cone): where
-    // both reach, the voxel holds the denser one, whichever is listed first.
+    // both reach, the voxel holds the denser one, whichever is listed first. Under the layer
+    // law a bough's extinction is uniform, so the denser is the same everywhere.
     const BoughSpec thin = test::paperBough(Vec3(-8.0, 0.0, 0.0), Vec3(1, 0, 0), 16.0);
     BoughSpec dense = test::paperBough(Vec3(0.0, -8.0, 0.3), Vec3(0, 1, 0), 16.0);
     dense.needles.cone.needlesPerCone = 24;
     dense.needleAlbedo = Vec3(0.5);
-    const BakeSettings settings{0.3, 1};
+    const BakeSettings settings{0.3, 1, "layer"};
     const TreeGrids ab = bakeBoughs({thin, dense}, settings);
     const TreeGrids ba = bakeBoughs({dense, thin}, settings);
     EXPECT_EQ(ab.densityScale_per_cm, ba.densityScale_per_cm);
@@ -188,7 +209,7 @@ TEST(BakeBoughs, PyramidLevelsAverageTheirChildrenAndKeepTheMass)
 {
     const BoughSpec b = test::paperBough(Vec3(1.1, -0.4, 2.0), Vec3(0.2, 0.9, 0.3), 20.0);
     const double h = 0.25;
-    const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 3});
+    const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 3, "layer"});
     ASSERT_EQ(g.densityPyramid.size(), 2u);
     const openvdb::FloatGrid* fine = g.density.get();
     for (std::size_t level = 0; level < 2; ++level) {
@@ -223,13 +244,13 @@ TEST(BakeBoughs, RejectsWhatItCannotBake)
     const BoughSpec b = test::paperBough(Vec3(0.0), Vec3(0, 0, 1), 5.0);
     EXPECT_THROW(bakeBoughs({b}, BakeSettings{0.0, 1}), BakeError);
     EXPECT_THROW(bakeBoughs({b}, BakeSettings{std::nan(""), 1}), BakeError);
-    EXPECT_THROW(bakeBoughs({b}, BakeSettings{0.5, 0}), BakeError);
+    EXPECT_THROW(bakeBoughs({b}, BakeSettings{0.5, 0, "layer"}), BakeError);
     BoughSpec bad = b;
     bad.needles.cone.aperture_rad = 2.0;
-    EXPECT_THROW(bakeBoughs({b, bad}, BakeSettings{0.5, 1}), BakeError);
+    EXPECT_THROW(bakeBoughs({b, bad}, BakeSettings{0.5, 1, "layer"}), BakeError);
     bad = b;
     bad.tip_cm.x = INFINITY;
-    EXPECT_THROW(bakeBoughs({bad}, BakeSettings{0.5, 1}), BakeError);
+    EXPECT_THROW(bakeBoughs({bad}, BakeSettings{0.5, 1, "layer"}), BakeError);
 }
 
 TEST(BakeBoughs, NothingToBakeGivesEmptyGrids)
@@ -237,7 +258,7 @@ TEST(BakeBoughs, NothingToBakeGivesEmptyGrids)
     BoughSpec zero = test::paperBough(Vec3(0.0), Vec3(0, 0, 1), 5.0);
     zero.tip_cm = zero.base_cm;
     for (const auto& boughs : {std::vector<BoughSpec>{}, std::vector<BoughSpec>{zero}}) {
-        const TreeGrids g = bakeBoughs(boughs, BakeSettings{0.5, 3});
+        const TreeGrids g = bakeBoughs(boughs, BakeSettings{0.5, 3, "layer"});
         ASSERT_TRUE(g.density && g.layerGradient && g.layerOpacity && g.needleDirection &&
                     g.needleAlbedo);
         EXPECT_EQ(g.density->activeVoxelCount(), 0u);

@@ -1,5 +1,6 @@
 // Writing and reading baked grids: round trip, what third-party tools see (vdb_print,
 // vdb_render, OpenVDB's own reader), and files we must refuse before OpenVDB parses them.
+#include "pine/bake/extinction_law.h"
 #include "pine/bake/tree_grids.h"
 #include "pine/support/atomic_file.h"
 
@@ -9,6 +10,7 @@
 #include <openvdb/io/Stream.h>
 
 #include <cstdlib>
+#include <iterator>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -97,11 +99,12 @@ TEST(TreeGridsIo, OpenVdbSeesAFogVolumeFirstWithItsProvenance)
     const openvdb::MetaMap::Ptr meta = in.getMetadata();
     in.close();
     // io::File lists grids by name; density comes first there too.
-    ASSERT_EQ(grids->size(), 7u);
+    ASSERT_EQ(grids->size(), std::size(kFields) + g.densityPyramid.size());
     EXPECT_EQ((*grids)[0]->getName(), "density");
     // In the file itself (io::Stream reads it in order) density is written first.
     const std::vector<std::string> names = {"density", "layer_gradient", "layer_opacity",
-                                            "needle_direction", "needle_albedo", "density_lod1",
+                                            "needle_direction", "needle_coverage", "needle_albedo",
+                                            "density_lod1",
                                             "density_lod2"};
     {
         std::ifstream raw(file, std::ios::binary);
@@ -131,9 +134,8 @@ TEST(TreeGridsIo, OpenVdbSeesAFogVolumeFirstWithItsProvenance)
     ASSERT_TRUE(meta);
     EXPECT_EQ(meta->metaValue<std::string>("pine:units"), "cm");
     EXPECT_EQ(meta->metaValue<openvdb::Int32>("pine:format_version"), kFormatVersion);
-    EXPECT_EQ(meta->metaValue<std::string>("pine:extinction_law"), "layer");
-    EXPECT_NE(meta->metaValue<std::string>("pine:extinction").find("-ln(1 - layer_opacity)"),
-              std::string::npos);
+    EXPECT_EQ(meta->metaValue<std::string>("pine:extinction_law"), "fibre");
+    EXPECT_EQ(meta->metaValue<std::string>("pine:extinction"), extinctionLaw("fibre").formula());
     EXPECT_EQ(meta->metaValue<double>("pine:voxel_size_cm"), 0.4);
     EXPECT_EQ(meta->metaValue<std::string>("pine:scene"), "scenes/test.json");
     EXPECT_EQ(meta->metaValue<openvdb::Int32>("pine:tree"), 7);
@@ -316,9 +318,9 @@ TEST(TreeGridsIo, AnotherFormatVersionOrAnUnknownLawIsRefused)
     rewrite(future);
     expectRefused(file, "format version " + std::to_string(kFormatVersion + 1));
     openvdb::MetaMap unknown = *meta;
-    unknown.insertMeta("pine:extinction_law", openvdb::StringMetadata("fibre"));
+    unknown.insertMeta("pine:extinction_law", openvdb::StringMetadata("dust"));
     rewrite(unknown);
-    expectRefused(file, "unknown extinction law 'fibre'");
+    expectRefused(file, "unknown extinction law 'dust'");
     // A pyramid level of another type is refused, not taken as the pyramid's end.
     openvdb::GridPtrVec wrongLod = *grids;
     wrongLod.push_back(openvdb::Vec3SGrid::create());
@@ -326,7 +328,7 @@ TEST(TreeGridsIo, AnotherFormatVersionOrAnUnknownLawIsRefused)
     rewrite(*meta, &wrongLod);
     expectRefused(file, "grid 'density_lod1' has type Tree_vec3s");
     rewrite(*meta);
-    EXPECT_EQ(readTreeGrids(file).extinctionLaw, "layer");
+    EXPECT_EQ(readTreeGrids(file).extinctionLaw, BakeSettings{}.extinctionLaw);
 }
 
 TEST(TreeGridsIo, UnwritableOutputIsABakeErrorAndLeavesNothing)

@@ -28,7 +28,7 @@ constexpr double kPi = analytic::kPi;
 struct LongBough {
     scenes::Scene scene;
     TracedScene traced;
-    LongBough(double angle_deg, const TracedSceneOptions& options, unsigned seed = 7,
+    LongBough(double angle_deg, const scenes::ModelChoices& model, unsigned seed = 7,
               const std::string& effects = R"("diffuse")")
     {
         scene = scenes::parseScene(R"({"name": "long bough",
@@ -37,7 +37,8 @@ struct LongBough {
   "lights": [{"type": "directional", "direction": [0.3, -1, 0.6]}],
   "ground": {"type": "none"}, "species": {}, "trees": [], "effects": [)" + effects + "]}",
                                    "long-bough.json");
-        traced = buildTracedScene(scene, options);
+        scene.render.model = model;
+        traced = buildTracedScene(scene);
         const double a = angle_deg * kPi / 180.0;
         const Vec3 axis(std::sin(a), std::cos(a), 0.0);
         BoughDescription d;
@@ -48,8 +49,8 @@ struct LongBough {
         d.seed = seed;
         const EffectsPlan plan = EffectsPlan::from(scene.effects);
         traced.boughs.push_back(makeTracedBough(d, scene.camera.position_cm, traced.lights,
-                                                boughLaw(options.boughLaw),
-                                                layerModel(options.layerModel),
+                                                boughLaw(model.boughLaw),
+                                                layerModel(model.layerModel),
                                                 {plan.selfShadowing, plan.shadowRays}));
         const TracedBough& b = traced.boughs.back();
         traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
@@ -73,7 +74,7 @@ double needles(double angle_deg, unsigned seed)
 double multiscale(double angle_deg, int level, const std::string& layers,
                   const std::string& law = "exact")
 {
-    TracedSceneOptions options;
+    scenes::ModelChoices options;
     options.layerModel = layers;
     options.boughLaw = law;
     MultiscaleOptions m;

@@ -22,6 +22,14 @@
 namespace pine::vdbtrace {
 namespace {
 
+// The reference as the paper models it: the layer law (these tests check E10, E12, E13).
+bake::BakeSettings paperBake(double voxel_cm)
+{
+    bake::BakeSettings settings = referenceBake(voxel_cm);
+    settings.extinctionLaw = "layer";
+    return settings;
+}
+
 using test::firScene;
 
 RenderResult renderJson(const std::string& json, int samples, unsigned seed = 0)
@@ -121,6 +129,7 @@ struct HandMade {
   "lights": [{"type": "directional", "direction": )" + lightDirection + R"(, "irradiance": 2}],
   "ground": {"type": "none"}, "species": {}, "trees": [], "effects": ["diffuse", "specular"]})",
                                    "hand-made.json");
+        scene.render.model = scenes::ModelChoices::paper();
         traced = buildTracedScene(scene);
     }
     TracedBough& add(const Vec3& base, const Vec3& axis, double length_cm,
@@ -250,7 +259,7 @@ TEST(GeometryTracer, MatchesTheReferenceOnAThinBoughUpToTheLayersObliquity)
     GeometryOptions options;
     options.samples = 64;
     const RenderResult geometry = renderGeometry(s.traced, options);
-    const bake::TreeGrids grids = bake::bakeBoughs(s.specs, referenceBake(0.1));
+    const bake::TreeGrids grids = bake::bakeBoughs(s.specs, paperBake(0.1));
     const RenderResult reference = renderReference(s.traced, grids);
     double covered[2] = {0.0, 0.0};
     for (std::size_t i = 3; i < geometry.image.rgba.size(); i += 4) {

@@ -144,6 +144,8 @@ struct SideOnBough {
   "lights": [{"type": "directional", "direction": [0, -1, 0.2]}],
   "ground": {"type": "none"}, "species": {}, "trees": [], "effects": [)" + effects + "]}",
                                    "side-on.json");
+        // The paper's layers: these tests check section 6 and errata E11-E12 as printed.
+        scene.render.model = scenes::ModelChoices::paper();
         traced = buildTracedScene(scene);
         BoughDescription d;
         d.spec.base_cm = Vec3(-40, 0, 0);
@@ -206,9 +208,23 @@ TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
         boughLaw("quadratic");
         ADD_FAILURE() << "no InputError";
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("linear"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("exact, linear"), std::string::npos) << e.what();
     }
-    EXPECT_EQ(boughLawNames().front(), "linear");
+    // The first registered is the scene's default.
+    EXPECT_EQ(boughLawNames().front(), scenes::ModelChoices{}.boughLaw);
+    EXPECT_EQ(layerModelNames().front(), scenes::ModelChoices{}.layerModel);
+    // A scene that names an unknown one is refused before any work, with its key.
+    scenes::Scene scene = scenes::parseScene(firScene(R"("diffuse")", 16, 12), "fir.json");
+    scene.render.model.layerModel = "foam";
+    try {
+        buildTracedScene(scene);
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("fir.json: render.layer_model: unknown layer model "
+                                             "'foam' (known: fibre, paper)"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 TEST(MultiscaleTracer, ConeLevelCrossesTheTrueCones)

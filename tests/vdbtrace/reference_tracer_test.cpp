@@ -17,6 +17,14 @@
 namespace pine::vdbtrace {
 namespace {
 
+// The reference as the paper models it: the layer law (these tests check E10, E12, E13).
+bake::BakeSettings paperBake(double voxel_cm)
+{
+    bake::BakeSettings settings = referenceBake(voxel_cm);
+    settings.extinctionLaw = "layer";
+    return settings;
+}
+
 // One long bough through the origin seen from -y, its axis turned by `tilt_rad` from x towards
 // +y (0: side-on, orthogonal to the view).
 struct SideOn {
@@ -32,6 +40,7 @@ struct SideOn {
   "lights": [{"type": "directional", "direction": [0, -1, 0.3]}],
   "ground": {"type": "none"}, "species": {}, "trees": [], "effects": ["diffuse"]})",
                                    "side-on.json");
+        scene.render.model = scenes::ModelChoices::paper();
         traced = buildTracedScene(scene);
         BoughDescription d;
         const Vec3 axis(std::cos(tilt_rad), std::sin(tilt_rad), 0);
@@ -52,7 +61,7 @@ struct SideOn {
 // its opacity is 1 - exp(-mu layers) (analytic/true_cone_bough.h).
 double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
 {
-    const bake::TreeGrids grids = bake::bakeBoughs(s.specs, referenceBake(voxel));
+    const bake::TreeGrids grids = bake::bakeBoughs(s.specs, paperBake(voxel));
     ReferenceOptions options;
     options.subpixels = 1;
     const RenderResult r = renderReference(s.traced, grids, options);
@@ -100,7 +109,7 @@ TEST(ReferenceTracer, NoBoughsRendersTransparent)
 {
     SideOn s;
     s.traced.boughs.clear();
-    const bake::TreeGrids grids = bake::bakeBoughs({}, referenceBake(0.5));
+    const bake::TreeGrids grids = bake::bakeBoughs({}, paperBake(0.5));
     const RenderResult r = renderReference(s.traced, grids);
     for (std::size_t i = 3; i < r.image.rgba.size(); i += 4) ASSERT_EQ(r.image.rgba[i], 0.0f);
 }

@@ -29,6 +29,7 @@ CompareRun runCompare(const CompareOptions& options)
     const std::filesystem::path& dir = options.outDir;
     io::checkWritableFolder(dir);
     scenes::Scene scene = scenes::loadScene(options.sceneFile);
+    if (options.model) options.model(scene.render.model);
     if (options.width > 0 && options.height > 0) {
         // fov_deg is vertical: the view is kept, and kept exactly when the aspect is.
         scene.camera.width = options.width;

@@ -13,7 +13,11 @@ RenderResult multiscale(const TracedScene& scene, const MethodSettings& s,
     return renderMultiscale(scene, s.multiscale, options);
 }
 
-nlohmann::json describeMultiscale(const MethodSettings&) { return nlohmann::json::object(); }
+nlohmann::json describeMultiscale(const scenes::Scene& scene, const MethodSettings&)
+{
+    return {{"bough_law", scene.render.model.boughLaw},
+            {"layer_model", scene.render.model.layerModel}};
+}
 
 RenderResult reference(const TracedScene& scene, const MethodSettings& s,
                        const RenderOptions& options)
@@ -22,7 +26,7 @@ RenderResult reference(const TracedScene& scene, const MethodSettings& s,
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     bake::BakeSettings baking = referenceBake(s.voxelSize_cm);
-    baking.extinctionLaw = s.extinctionLaw;
+    baking.extinctionLaw = scene.scene->render.model.extinctionLaw;
     const bake::TreeGrids grids = bake::bakeScene(scene.trees, baking);
     const double bakeSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     RenderResult result = renderReference(scene, grids, s.reference, options);
@@ -31,10 +35,12 @@ RenderResult reference(const TracedScene& scene, const MethodSettings& s,
     return result;
 }
 
-nlohmann::json describeReference(const MethodSettings& s)
+nlohmann::json describeReference(const scenes::Scene& scene, const MethodSettings& s)
 {
     return {{"voxel_size_cm", s.grids ? s.grids->voxelSize_cm : s.voxelSize_cm},
-            {"rays_per_pixel", s.reference.subpixels * s.reference.subpixels}};
+            {"rays_per_pixel", s.reference.subpixels * s.reference.subpixels},
+            {"extinction_law",
+             s.grids ? s.grids->extinctionLaw : scene.render.model.extinctionLaw}};
 }
 
 RenderResult geometry(const TracedScene& scene, const MethodSettings& s,
@@ -43,7 +49,7 @@ RenderResult geometry(const TracedScene& scene, const MethodSettings& s,
     return renderGeometry(scene, s.geometry, options);
 }
 
-nlohmann::json describeGeometry(const MethodSettings& s)
+nlohmann::json describeGeometry(const scenes::Scene&, const MethodSettings& s)
 {
     return {{"samples_per_pixel", s.geometry.samples}};
 }

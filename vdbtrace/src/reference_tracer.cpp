@@ -63,13 +63,14 @@ void walkVoxels(const Vec3& o, const Vec3& d, double h, double t0, double t1, Vi
 struct FieldReader {
     const bake::ExtinctionLaw& law;
     openvdb::Vec3SGrid::ConstAccessor gradient, needle, albedo;
-    openvdb::FloatGrid::ConstAccessor opacity;
+    openvdb::FloatGrid::ConstAccessor opacity, coverage;
     explicit FieldReader(const bake::TreeGrids& g)
         : law(bake::extinctionLaw(g.extinctionLaw)),
           gradient(g.layerGradient->getConstAccessor()),
           needle(g.needleDirection->getConstAccessor()),
           albedo(g.needleAlbedo->getConstAccessor()),
-          opacity(g.layerOpacity->getConstAccessor())
+          opacity(g.layerOpacity->getConstAccessor()),
+          coverage(g.needleCoverage->getConstAccessor())
     {
     }
     /// sigma(d) at voxel ijk, per cm; 0 outside the boughs.
@@ -81,6 +82,7 @@ struct FieldReader {
         field.layerOpacity = A;
         field.gradient = toGlm(gradient.getValue(ijk));
         field.needle = toGlm(needle.getValue(ijk));
+        field.needleCoverage = coverage.getValue(ijk);
         return law.extinction(field, d);
     }
 };

@@ -1,9 +1,10 @@
 #include "pine/vdbtrace/traced_scene.h"
 
 #include "pine/analytic/cone_shader.h"
+#include "pine/analytic/direction.h"
 #include "pine/bake/tree_boughs.h"
 #include "pine/scenes/colours.h"
-#include "pine/analytic/direction.h"
+#include "pine/support/input_error.h"
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/layer_model.h"
 
@@ -127,10 +128,22 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
     return b;
 }
 
-TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneOptions& options)
+TracedScene buildTracedScene(const scenes::Scene& scene)
 {
-    const BoughLaw& law = boughLaw(options.boughLaw);
-    const LayerModel& layers = layerModel(options.layerModel);
+    const scenes::ModelChoices& model = scene.render.model;
+    const auto chosen = [&](const char* key, auto&& lookUp) -> decltype(auto) {
+        try {
+            return lookUp();
+        } catch (const InputError& e) {
+            throw InputError(scene.source.string() + ": render." + key + ": " + e.what());
+        }
+    };
+    const BoughLaw& law = chosen("bough_law", [&]() -> const BoughLaw& {
+        return boughLaw(model.boughLaw);
+    });
+    const LayerModel& layers = chosen("layer_model", [&]() -> const LayerModel& {
+        return layerModel(model.layerModel);
+    });
     const EffectsPlan plan = EffectsPlan::from(scene.effects);
     const BoughLawNeeds needs{plan.selfShadowing, plan.shadowRays};
     TracedScene out;

@@ -10,6 +10,7 @@
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
+#include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/preview.h"
@@ -46,16 +47,47 @@ vdbtrace::RenderOptions withProgress(const std::string& what)
     return options;
 }
 
+// The command line's choice of models, over the scene's (render.preset and the keys after
+// it): --paper first, then each law named.
+struct ModelOverrides {
+    bool paper = false;
+    std::string boughLaw, layerModel, extinctionLaw;
+
+    void add(CLI::App& cmd)
+    {
+        cmd.add_flag("--paper", paper,
+                     "Every approximation as the paper prints it (render.preset \"paper\"): "
+                     "bough law linear, layer model paper, extinction law layer");
+        cmd.add_option("--bough-law", boughLaw, "multiscale level 3's law (render.bough_law)")
+            ->check(CLI::IsMember(vdbtrace::boughLawNames()));
+        cmd.add_option("--layer-model", layerModel,
+                       "multiscale: a layer's opacity (render.layer_model)")
+            ->check(CLI::IsMember(vdbtrace::layerModelNames()));
+        cmd.add_option("--extinction-law", extinctionLaw,
+                       "reference: the law of the bake, without --grids, whose files name "
+                       "theirs (render.extinction_law)")
+            ->check(CLI::IsMember(bake::extinctionLawNames()));
+    }
+    void apply(scenes::ModelChoices& model) const
+    {
+        if (paper) model = scenes::ModelChoices::paper();
+        if (!boughLaw.empty()) model.boughLaw = boughLaw;
+        if (!layerModel.empty()) model.layerModel = layerModel;
+        if (!extinctionLaw.empty()) model.extinctionLaw = extinctionLaw;
+    }
+};
+
 struct Loaded {
     scenes::Scene scene;
     vdbtrace::TracedScene traced;
 };
 
-std::unique_ptr<Loaded> load(const fs::path& file, const vdbtrace::TracedSceneOptions& options)
+std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model)
 {
     auto loaded = std::make_unique<Loaded>();
     loaded->scene = scenes::loadScene(file);
-    loaded->traced = vdbtrace::buildTracedScene(loaded->scene, options);
+    model.apply(loaded->scene.render.model);
+    loaded->traced = vdbtrace::buildTracedScene(loaded->scene);
     return loaded;
 }
 
@@ -81,7 +113,7 @@ fs::path besideWith(const fs::path& image, const std::string& suffix)
 int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs,
            vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles,
-           const vdbtrace::TracedSceneOptions& model)
+           const ModelOverrides& model)
 {
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
     io::checkWritable(out);
@@ -114,7 +146,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
 
     const auto& s = loaded->scene;
     const nlohmann::json effects = vdbtrace::toJson(vdbtrace::EffectsPlan::from(s.effects));
-    const nlohmann::json methodSettings = method.describe(settings);
+    const nlohmann::json methodSettings = method.describe(s, settings);
     vdbtrace::Metadata metadata = {
         {"pine:scene", sceneFile.string()},
         {"pine:method", methodName},
@@ -126,7 +158,6 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                                       " (footprint / cone spacing)"},
         {"pine:units", "cm"},
         {"pine:prep_seconds", std::to_string(result.prepSeconds)}};
-    if (methodName == "multiscale") metadata.emplace_back("pine:bough_law", model.boughLaw);
     for (const auto& [key, value] : methodSettings.items()) {
         metadata.emplace_back("pine:" + key, value.dump());
     }
@@ -172,9 +203,10 @@ vdbtrace::RenderResult timed(const scenes::Scene& scene, const std::string& labe
     return r;
 }
 
-int bench(const fs::path& sceneFile, bool scaling)
+int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model)
 {
-    const scenes::Scene scene = scenes::loadScene(sceneFile);
+    scenes::Scene scene = scenes::loadScene(sceneFile);
+    model.apply(scene.render.model);
     double buildSeconds = 0.0;
     const vdbtrace::RenderResult r = timed(scene, "bench", &buildSeconds);
     const auto& st = r.stats;
@@ -275,11 +307,6 @@ int main(int argc, char** argv)
     renderCmd->add_option("--voxel-size", settings.voxelSize_cm,
                           "reference: voxel size of the baked boughs, cm")
         ->check(CLI::PositiveNumber);
-    renderCmd->add_option("--extinction-law", settings.extinctionLaw,
-                          "reference: the law of the bake (without --grids, whose files name "
-                          "theirs)")
-        ->check(CLI::IsMember(bake::extinctionLawNames()))
-        ->capture_default_str();
     renderCmd->add_option("--grids", gridFiles,
                           "reference: baked .vdb files (bake tree/scene) instead of baking now")
         ->check(CLI::ExistingFile);
@@ -294,10 +321,8 @@ int main(int argc, char** argv)
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
         ->check(CLI::IsMember({"level"}));
-    vdbtrace::TracedSceneOptions model;
-    renderCmd->add_option("--bough-law", model.boughLaw, "multiscale level 3's law")
-        ->check(CLI::IsMember(vdbtrace::boughLawNames()))
-        ->capture_default_str();
+    ModelOverrides model;
+    model.add(*renderCmd);
     renderCmd->add_option("--force-level", settings.multiscale.forceLevel,
                           "multiscale: shade every bough hit at level 1, 2 or 3")
         ->check(CLI::Range(0, 3));
@@ -308,6 +333,7 @@ int main(int argc, char** argv)
     benchCmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
     benchCmd->add_flag("--scaling", scaling,
                        "Also render with N x 2 and dh / 2 (section 7's scaling claim)");
+    model.add(*benchCmd);
 
     fs::path diffA, diffB, diffOut;
     double diffScale = 0.0;
@@ -340,6 +366,7 @@ int main(int argc, char** argv)
                                                           : "expected WxH, e.g. 64x48";
         });
     compareCmd->add_flag("--no-plot", noPlot, "Skip error_vs_time.png (matplotlib)");
+    model.add(*compareCmd);
 
     return tool::run("vdbtrace", app, argc, argv, [&] {
         if (*renderCmd) {
@@ -349,6 +376,7 @@ int main(int argc, char** argv)
         if (*compareCmd) {
             compare.settings = vdbtrace::CompareSettings::forQuick(quick);
             compare.machine = machineDescription();
+            compare.model = [&model](scenes::ModelChoices& m) { model.apply(m); };
             compare.log = [](const std::string& line) {
                 std::cerr << "vdbtrace compare: " << line << '\n';
             };
@@ -359,6 +387,6 @@ int main(int argc, char** argv)
             vdbtrace::runCompare(compare);
             return 0;
         }
-        return bench(sceneFile, scaling);
+        return bench(sceneFile, scaling, model);
     });
 }

@@ -35,6 +35,9 @@ struct LayerSample {
     Vec3 gradient{0.0};         ///< G = (axis - cot(phi) radial) / dh, layers per cm
     Vec3 needle{0.0};           ///< unit needle direction there: cos(phi) axis + sin(phi) radial
     double layerOpacity = 0.0;  ///< A = 2 N r / (pi R)
+    /// The needles' coverage of their cone here, min(1, N r / (pi rho)): they fan out from
+    /// the axis, so their mean over the cone's area is A (errata E13).
+    double needleCoverage = 0.0;
     /// mu = -ln(1 - A): extinction per layer crossed (docs/errata.md, E10), capped at
     /// kMaxLayerExtinction so that A = 1 stays finite. (added)
     double layerExtinction() const;

@@ -23,7 +23,14 @@ public:
 
 /// The fields a bake writes, in the file's order: density first, so that tools that take the
 /// first grid (vdb_render) find it.
-enum class Field { Density, LayerGradient, LayerOpacity, NeedleDirection, NeedleAlbedo };
+enum class Field {
+    Density,
+    LayerGradient,
+    LayerOpacity,
+    NeedleDirection,
+    NeedleCoverage,
+    NeedleAlbedo
+};
 
 struct FieldInfo {
     Field field;
@@ -46,6 +53,8 @@ inline constexpr FieldInfo kFields[] = {
      "A = 2 N r / (pi R), the opacity of one layer"},
     {Field::NeedleDirection, "needle_direction", true, openvdb::VEC_CONTRAVARIANT_RELATIVE,
      "unit needle direction, cos(phi) axis + sin(phi) radial"},
+    {Field::NeedleCoverage, "needle_coverage", false, openvdb::VEC_INVARIANT,
+     "min(1, N r / (pi rho)): the needles' coverage of their cone there (fibre law)"},
     {Field::NeedleAlbedo, "needle_albedo", true, openvdb::VEC_INVARIANT,
      "needle albedo, linear RGB"},
 };
@@ -57,13 +66,13 @@ inline std::string densityLodName(int level)
 }
 
 /// The layout of what writeTreeGrids writes (pine:format_version); readTreeGrids refuses
-/// another. 2: the first with a version and an extinction law by name.
-inline constexpr int kFormatVersion = 2;
+/// another. 2: the first with a version and an extinction law by name; 3: needle_coverage.
+inline constexpr int kFormatVersion = 3;
 
 struct BakeSettings {
     double voxelSize_cm = 0.5;
     int pyramidLevels = 3;  ///< density at voxel sizes h, 2h, 4h, ...: "density_lod1", ...
-    std::string extinctionLaw = "layer";  ///< a name of extinctionLawNames()
+    std::string extinctionLaw = "fibre";  ///< a name of extinctionLawNames()
 };
 
 /// A tree's grids in world space (cm), all on one transform of voxel size h, voxels sampled at
@@ -74,6 +83,7 @@ struct TreeGrids {
     openvdb::Vec3SGrid::Ptr layerGradient;
     openvdb::FloatGrid::Ptr layerOpacity;
     openvdb::Vec3SGrid::Ptr needleDirection;
+    openvdb::FloatGrid::Ptr needleCoverage;
     openvdb::Vec3SGrid::Ptr needleAlbedo;
     /// Coarser densities, lod 1, 2, ...: lod k has voxels of 2^k h, each the mean of its 8
     /// children, centred on their mean centre (its own transform, shifted by (2^k - 1) h / 2).

@@ -78,8 +78,21 @@ struct TreePlacement {
     unsigned seed = 1;
 };
 
+/// The model of each approximation the paper makes (docs/models.md), by name: vdbtrace and
+/// bake look each up in their registries, which refuse an unknown one.
+struct ModelChoices {
+    std::string boughLaw = "exact";       ///< level 3's law: "exact" or "linear" (sec. 6.6)
+    std::string layerModel = "fibre";     ///< a layer's opacity: "fibre" or "paper" (const. A)
+    std::string extinctionLaw = "fibre";  ///< the reference's field: "fibre" or "layer"
+    /// Every choice as the paper prints it (preset "paper"): today's published behaviour.
+    static ModelChoices paper() { return {"linear", "paper", "layer"}; }
+    /// The choices that agree with the explicit needles (preset "faithful", the default).
+    static ModelChoices faithful() { return {}; }
+};
+
 struct RenderSettings {
     Vec3 background{0.55, 0.7, 0.9};
+    ModelChoices model;  ///< preset, then bough_law, layer_model, extinction_law
     /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
     /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):
     /// q < needleLevelMax: level 1, needles resolved; q < coneLevelMax: level 2, each cone a

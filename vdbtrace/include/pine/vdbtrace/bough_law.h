@@ -1,6 +1,6 @@
 // Level 3's law: how a bough, shaded as a volume (paper section 6), covers the pixel and passes
 // light. A law is a type registered by name in src/bough_laws.cpp and chosen once per render
-// (TracedSceneOptions::boughLaw): the view opacity, each light's transfer and each light's
+// (the scene's render.bough_law): the view opacity, each light's transfer and each light's
 // opacity all come from the same law, in one call, so that no render mixes two laws. Each is a
 // profile across the bough's strip (strip_profile.h): the paper's laws are one value for the
 // whole strip, the exact law a function of the chord's offset.

@@ -14,6 +14,8 @@ struct CompareOptions {
     std::filesystem::path sceneFile;
     std::filesystem::path outDir;
     CompareSettings settings;
+    /// Adjusts the scene's model choices after it is read (the command line's overrides).
+    std::function<void(scenes::ModelChoices&)> model;
     int width = 0, height = 0;  ///< override of the camera's resolution (0: the scene's)
     bool flicker = true;        ///< render the dolly (flicker.csv)
     std::string machine = "unknown machine";  ///< for the report: CPU, cores, threads

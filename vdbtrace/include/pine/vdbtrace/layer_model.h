@@ -1,7 +1,7 @@
 // How much one layer of needles stops a line that crosses it (docs/errata.md E13): the choice
 // every level that sees a bough's cones as layers makes (level 2, the self-shadowing of levels
 // 1-2, and level 3's exact law). A model is a type registered by name in src/layer_models.cpp
-// and chosen once per render (TracedSceneOptions::layerModel).
+// and chosen once per render (the scene's render.layer_model).
 #pragma once
 
 #include "pine/vdbtrace/traced_scene.h"

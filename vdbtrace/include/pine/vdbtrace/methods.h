@@ -20,7 +20,6 @@ struct MethodSettings {
     ReferenceOptions reference;
     /// reference: without `grids`, the scene's trees are baked (bake::bakeScene) at this size
     double voxelSize_cm = 0.25;
-    std::string extinctionLaw = "layer";     ///< reference: the law of that bake
     const bake::TreeGrids* grids = nullptr;  ///< reference: grids read from files instead
     GeometryOptions geometry;
 };
@@ -33,7 +32,7 @@ struct RenderMethod {
     RenderResult (*render)(const TracedScene& scene, const MethodSettings& settings,
                            const RenderOptions& options);
     /// The settings the method reads, as the stats JSON and the EXR header record them.
-    nlohmann::json (*describe)(const MethodSettings& settings);
+    nlohmann::json (*describe)(const scenes::Scene& scene, const MethodSettings& settings);
 };
 
 /// The registered methods: multiscale, reference, geometry.

@@ -19,7 +19,7 @@ struct MultiscaleOptions {
 
 /// Renders with the closed forms: needles (level 1) as anti-aliased cylinders, cones (level 2)
 /// by eqs. (4)-(6) at each crossing of the true cones, boughs (level 3) as section 6's volume
-/// under the scene's bough law (TracedSceneOptions), lit through cone shadow rays.
+/// under the scene's bough law (render.bough_law), lit through cone shadow rays.
 RenderResult renderMultiscale(const TracedScene& scene, const MultiscaleOptions& method = {},
                               const RenderOptions& options = {});
 

@@ -106,14 +106,9 @@ struct TracedScene {
     }
 };
 
-/// The choices of model that preparing a scene makes.
-struct TracedSceneOptions {
-    std::string boughLaw = "linear";     ///< a name of boughLawNames()
-    std::string layerModel = "paper";    ///< a name of layerModelNames()
-};
-
-/// Grows every tree and prepares the scene for its camera, in parallel. Keeps a pointer to
-/// `scene`, which must outlive the result. Throws InputError for an unknown law or model.
-TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneOptions& options = {});
+/// Grows every tree and prepares the scene for its camera under the scene's bough law and
+/// layer model (scene.render.model), in parallel. Keeps a pointer to `scene`, which must
+/// outlive the result. Throws InputError for an unknown law or model, naming the scene's key.
+TracedScene buildTracedScene(const scenes::Scene& scene);
 
 }  // namespace pine::vdbtrace
