@@ -17,9 +17,11 @@ namespace pine::vdbtrace {
 namespace {
 
 // Cells across the strip and chords per cell, at axial positions dh / kPhases apart, so that
-// each cell averages over where the cones fall.
+// each cell averages over where the cones fall. A chord's opacity is even in its offset (the
+// mirror through the plane of the axis and the chord maps cones onto cones), so opacities are
+// computed on half the cells; transfers are not even (the light is on one side).
 constexpr int kCells = 12;
-constexpr int kPhases = 3;
+constexpr int kPhases = 2;
 // Below this transmittance a chord stops: nothing behind shows.
 constexpr double kOpaque = 1e-4;
 
@@ -49,6 +51,11 @@ public:
         std::vector<double> front(kCells, 0.0), rear(kCells, 0.0);
         std::vector<std::vector<double>> litFront(lights, front), litRear(lights, front);
         for (int k = 0; k < kCells; ++k) {
+            if (!needs.transfer && k >= kCells / 2) {
+                front[k] = front[kCells - 1 - k];
+                rear[k] = rear[kCells - 1 - k];
+                continue;
+            }
             for (int p = 0; p < kPhases; ++p) {
                 Vec3 o;
                 double tIn, tOut;
@@ -92,6 +99,10 @@ private:
         const Vec3 across = stripAcross(b.axis, -d);
         std::vector<double> cells(kCells, 0.0);
         for (int k = 0; k < kCells; ++k) {
+            if (k >= kCells / 2) {
+                cells[k] = cells[kCells - 1 - k];
+                continue;
+            }
             for (int p = 0; p < kPhases; ++p) {
                 Vec3 o;
                 double tIn, tOut;

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -55,6 +56,7 @@ private:
     RenderStats& mStats;
     SurfaceShading mSurfaces;
     std::vector<Fragment> mFragments;
+    std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
 };
 
 void MultiscaleRayTracer::shadeNeedle(const TracedBough& b, long cone, const Vec3& needle,
@@ -113,12 +115,17 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
         });
         return;
     }
-    forEachConeCrossing(b, ray.origin, ray.direction, tIn, tOut, [&](long j, double tc) {
+    // Level 1: the needles of each cone the ray passes (cone_crossings.h's bands: also where it
+    // passes a cone without crossing it, as along its silhouette), nearest the azimuth where
+    // it passes them, as cylinders; each needle once, though the ray may pass its cone twice.
+    mNeedlesSeen.clear();
+    forEachConeBand(b, ray.origin, ray.direction, tIn, tOut, [&](const ConeBand& band) {
+        const long j = band.cone;
+        const double tc = band.t;
         double rho;
         Vec3 radial;
         coneHeight(b, cotPhi, ray.origin + tc * ray.direction, &rho, &radial);
-        if (!(rho > 1e-9)) return;
-        // Level 1: the cone's needles nearest the crossing's azimuth, as cylinders.
+        if (!(rho > 1e-9)) return true;
         const double theta = std::atan2(glm::dot(radial, e2), glm::dot(radial, e1));
         const long nearest = std::lround((theta - layout.roll(j)) * needles / (2 * kPi));
         const Vec3 apex = layout.apex(j);
@@ -127,6 +134,11 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
         const long from = needles >= 3 ? nearest - 1 : 0;
         const long to = needles >= 3 ? nearest + 1 : needles - 1;
         for (long i = from; i <= to; ++i) {
+            const std::pair<long, long> key{j, ((i % needles) + needles) % needles};
+            if (std::find(mNeedlesSeen.begin(), mNeedlesSeen.end(), key) != mNeedlesSeen.end()) {
+                continue;
+            }
+            mNeedlesSeen.push_back(key);
             const Vec3 needle = layout.direction(layout.azimuth(j, i));
             Passage p;
             if (!closestPassage(ray, apex, apex + l * needle, p)) continue;
@@ -135,6 +147,7 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
             ++mStats.needleHits;
             shadeNeedle(b, j, needle, ray.origin + p.t * ray.direction, V, c, p.t, 1, light);
         }
+        return true;
     });
 }
 
