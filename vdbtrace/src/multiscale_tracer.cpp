@@ -42,7 +42,7 @@ private:
     }
     void addBough(const ConeRay& ray, std::size_t index);
     void addCrossings(const ConeRay& ray, std::size_t index, const TracedBough& b, double tIn,
-                      double tOut, double coverage, Level level);
+                      double tOut, double coverage, double xi, Level level);
     // A needle of cone `cone` at x, its light through the bough's other layers under the
     // layer model (section 6's self-shadowing at levels 1-2, counted, not approximated).
     void shadeNeedle(const TracedBough& b, long cone, const Vec3& needle, const Vec3& x,
@@ -57,6 +57,7 @@ private:
     SurfaceShading mSurfaces;
     std::vector<Fragment> mFragments;
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
+    std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
 };
 
 void MultiscaleRayTracer::shadeNeedle(const TracedBough& b, long cone, const Vec3& needle,
@@ -87,7 +88,7 @@ void MultiscaleRayTracer::shadeNeedle(const TracedBough& b, long cone, const Vec
 
 void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
                                        const TracedBough& b, double tIn, double tOut,
-                                       double coverage, Level level)
+                                       double coverage, double xi, Level level)
 {
     const double phi = b.geometry.cone.aperture_rad;
     const double cotPhi = 1.0 / std::tan(phi), sinPhi = std::sin(phi), cosPhi = std::cos(phi);
@@ -103,16 +104,32 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
 
     if (level == Level::Cone) {
         // Level 2: each layer as the layer model stops the ray, shaded as its needle there.
-        mScene.layers->layers(b, ray.origin, ray.direction, tIn, tOut, [&](const LayerHit& hit) {
+        // The bough covers `coverage` of the footprint and its layers lie over one another
+        // within it: together they cover coverage (1 - prod(1 - alpha_i)), which each layer
+        // composited alone with coverage alpha_i would exceed where coverage < 1 (the edge of
+        // the strip). So each layer's share of the bough's coverage is what it composites.
+        mLayerHits.clear();
+        mScene.layers->layers(b, ray.origin, ray.direction, tIn, tOut,
+                              [&](const LayerHit& hit) { mLayerHits.push_back(hit); });
+        std::stable_sort(mLayerHits.begin(), mLayerHits.end(),
+                         [](const LayerHit& x, const LayerHit& y) { return x.t < y.t; });
+        double covered = 0.0;  // by this bough's layers in front, of the footprint
+        for (const LayerHit& hit : mLayerHits) {
             double rho;
             Vec3 radial;
             coneHeight(b, cotPhi, ray.origin + hit.t * ray.direction, &rho, &radial);
-            if (!(rho > 1e-9)) return;
+            if (!(rho > 1e-9)) continue;
             ++mStats.coneHits;
+            double alpha = coverage * hit.opacity;
+            if (coverage < 1.0) {
+                const double share = (coverage - covered) * hit.opacity;
+                alpha = covered < 1.0 ? share / (1.0 - covered) : 0.0;
+                covered += share;
+            }
             const Vec3 needle = cosPhi * b.axis + sinPhi * radial;
-            shadeNeedle(b, hit.cone, needle, ray.origin + hit.t * ray.direction, V,
-                        coverage * hit.opacity, hit.t, 2, light);
-        });
+            shadeNeedle(b, hit.cone, needle, ray.origin + hit.t * ray.direction, V, alpha,
+                        hit.t, 2, light);
+        }
         return;
     }
     // Level 1: the needles of each cone the ray passes (cone_crossings.h's bands: also where it
@@ -170,7 +187,7 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
         // Cones and needles are found along the cone's axis; where the axis misses them the
         // footprint only grazes the bough: shade the volume.
         if (intersectCylinder(ray, b.base_cm, b.conesEnd_cm, b.radius_cm, tIn, tOut)) {
-            addCrossings(ray, index, b, tIn, tOut, c, level);
+            addCrossings(ray, index, b, tIn, tOut, c, xi, level);
             return;
         }
     }
