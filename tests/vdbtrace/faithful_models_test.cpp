@@ -169,10 +169,12 @@ TEST(FaithfulModels, ARecedingBoughNeitherPopsNorFades)
     // coverage summed over the pixels times a pixel's area at the boughs, over the frame's
     // width, which rounding to whole pixels changes a little) and their luminance likewise.
     // Coverage changes by less than 2% across both level thresholds (q = 0.25 and 1), the
-    // luminance by up to 2.4% (measured; bounded at 2.5%). Within level 2 one ray per pixel
-    // samples the strip at a few offsets when the footprint nears dh (4 rows across the strip
-    // at q = 0.9), so that the total moves with the pixel grid's phase: measured up to 3%
-    // between neighbours, bounded at 4%, and it is most of the jumps at the thresholds.
+    // luminance by up to 2.4% (measured; bounded at 2.5%). Level 2 is point-sampled, one ray
+    // per pixel, and as the footprint nears dh the pixels sample the cones at about their own
+    // spacing, along the strip and across it: the total moves with the pixel grid's phase
+    // (measured +-2% around its mean for q from 0.6 to 1 in steps of 3%; two lines per
+    // pixel across the strip did not reduce it), bounded at 4% between neighbours, and it is
+    // most of the jumps at the thresholds.
     // Levels 1 and 3 are anti-aliased across the strip and move by less than 1%. The curve
     // is printed.
     double previousCoverage = 0.0, previousLuminance = 0.0;
