@@ -42,7 +42,7 @@ private:
     }
     void addBough(const ConeRay& ray, std::size_t index);
     void addCrossings(const ConeRay& ray, std::size_t index, const TracedBough& b, double tIn,
-                      double tOut, double coverage, double xi, Level level);
+                      double tOut, double coverage, Level level);
     // A needle of cone `cone` at x, its light through the bough's other layers under the
     // layer model (section 6's self-shadowing at levels 1-2, counted, not approximated).
     void shadeNeedle(const TracedBough& b, long cone, const Vec3& needle, const Vec3& x,
@@ -88,7 +88,7 @@ void MultiscaleRayTracer::shadeNeedle(const TracedBough& b, long cone, const Vec
 
 void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
                                        const TracedBough& b, double tIn, double tOut,
-                                       double coverage, double xi, Level level)
+                                       double coverage, Level level)
 {
     const double phi = b.geometry.cone.aperture_rad;
     const double cotPhi = 1.0 / std::tan(phi), sinPhi = std::sin(phi), cosPhi = std::cos(phi);
@@ -187,7 +187,7 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
         // Cones and needles are found along the cone's axis; where the axis misses them the
         // footprint only grazes the bough: shade the volume.
         if (intersectCylinder(ray, b.base_cm, b.conesEnd_cm, b.radius_cm, tIn, tOut)) {
-            addCrossings(ray, index, b, tIn, tOut, c, xi, level);
+            addCrossings(ray, index, b, tIn, tOut, c, level);
             return;
         }
     }
