@@ -168,8 +168,10 @@ TEST(FaithfulModels, ARecedingBoughNeitherPopsNorFades)
     // a few pixels tall) in steps of 1.25x: the boughs' covered width (the area they cover,
     // coverage summed over the pixels times a pixel's area at the boughs, over the frame's
     // width, which rounding to whole pixels changes a little) and their luminance likewise.
-    // Coverage changes by less than 2% across both level thresholds (q = 0.25 and 1), the
-    // luminance by up to 2.4% (measured; bounded at 2.5%). Level 2 is point-sampled, one ray
+    // Coverage changes by less than 2% across both level thresholds (q = 0.25 and 1). The
+    // luminance by up to 3.4% at q = 1 (measured; bounded at 3.5%): level 3 shades each half
+    // with its face's mean reflectance (section 6.6's I^cyl), where levels 1-2 shade each
+    // needle; the exact law keeps that closed form. Level 2 is point-sampled, one ray
     // per pixel, and as the footprint nears dh the pixels sample the cones at about their own
     // spacing, along the strip and across it: the total moves with the pixel grid's phase
     // (measured +-2% around its mean for q from 0.6 to 1 in steps of 3%; two lines per
@@ -198,11 +200,12 @@ TEST(FaithfulModels, ARecedingBoughNeitherPopsNorFades)
         std::printf("q %7.3f  %4dx%-4d  level %d  covered width %.4f cm  luminance %.6f\n", q,
                     r.image.width, r.image.height, level, coverage, lum);
         if (previousCoverage > 0.0) {
-            const double bound = level == 2 && previousLevel == 2 ? 0.04
-                                 : level != previousLevel         ? 0.025
-                                                                  : 0.01;
-            EXPECT_NEAR(coverage / previousCoverage, 1.0, bound) << "q " << q;
-            EXPECT_NEAR(lum / previousLuminance, 1.0, bound) << "q " << q;
+            const bool within2 = level == 2 && previousLevel == 2;
+            const bool across = level != previousLevel;
+            EXPECT_NEAR(coverage / previousCoverage, 1.0, within2 ? 0.04 : across ? 0.02 : 0.01)
+                << "q " << q;
+            EXPECT_NEAR(lum / previousLuminance, 1.0, within2 ? 0.04 : across ? 0.035 : 0.01)
+                << "q " << q;
         }
         previousCoverage = coverage;
         previousLuminance = lum;

@@ -191,9 +191,12 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
             return;
         }
     }
-    // The volume spans base to tip (the cones' region sheared into a cylinder of equal volume).
-    if (!closestPassage(ray, b.base_cm, b.tip_cm, p)) return;
-    if (!intersectCylinder(ray, b.base_cm, b.tip_cm, b.radius_cm, tIn, tOut)) tIn = tOut = p.t;
+    // The volume spans base to the law's strip end: the tip (the cones' region sheared into a
+    // cylinder of equal volume) or the cones' end (the exact law, whose chords cover them).
+    if (!closestPassage(ray, b.base_cm, b.stripEnd_cm, p)) return;
+    if (!intersectCylinder(ray, b.base_cm, b.stripEnd_cm, b.radius_cm, tIn, tOut)) {
+        tIn = tOut = p.t;
+    }
 
     // Level 3: section 6 per light under the bough law, front half at the entry and rear
     // half at the middle, so that the branch inside sorts between them. Each profile is read

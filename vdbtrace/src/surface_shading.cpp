@@ -27,7 +27,7 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
             }
         } else {
             const TracedBough& b = scene.bough(index);
-            if (closestPassage(ray, b.base_cm, b.tip_cm, p) && p.t < tMax) {
+            if (closestPassage(ray, b.base_cm, b.stripEnd_cm, p) && p.t < tMax) {
                 transmittance *= 1.0 - b.lighting[light].opacityFromLight.overFootprint(
                                            p.gap, b.radius_cm, ray.width(p.t));
             }

@@ -114,6 +114,7 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
     const BoughShading shading = law.shade(b, V, towards, layers, needs);
     b.alpha = shading.alpha;
     b.rearComposite = shading.rear;
+    b.stripEnd_cm = shading.stripToConesEnd ? b.conesEnd_cm : b.tip_cm;
     for (std::size_t i = 0; i < lights.size(); ++i) {
         const auto sums = analytic::coneSums(
             cone, analytic::coneIntegrals(cone.aperture_rad, b.axis, towards[i], V, b.exponent),

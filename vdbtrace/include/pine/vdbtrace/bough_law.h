@@ -50,6 +50,9 @@ struct BoughLawNeeds {
 struct BoughShading {
     FrontRearProfile alpha;  ///< opacity of each half seen from the camera, across its strip
     RearComposite rear = RearComposite::Own;
+    /// The strip the profiles are drawn on runs from the base to the cones' end (where the last
+    /// cone's needles end), not to the tip: level 3 and shadows then draw it so.
+    bool stripToConesEnd = false;
     std::vector<BoughLightTransfer> lights;  ///< one per light, in the scene's order
 };
 

@@ -63,6 +63,8 @@ struct TracedBough {
     /// needles (levels 1-2) are found up to here; the volume (level 3) spans base to tip, which
     /// holds the same amount of needles (the layered region is that cylinder, sheared).
     Vec3 conesEnd_cm;
+    /// Where the strip level 3 draws ends: tip_cm or conesEnd_cm, as the law's profiles say.
+    Vec3 stripEnd_cm;
     analytic::BoughGeometry geometry;  ///< needle parameters at mid-bough (section 3.1)
     double radius_cm = 0.0;            ///< R = l sin(phi)
     double layerOpacity = 0.0;         ///< A
