@@ -55,12 +55,21 @@ void summarize(const Totals& totals, std::chrono::steady_clock::time_point start
                  tool::peakMemoryMiB());
 }
 
-int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& settings,
-            const fs::path& out)
+// The scene's extinction law (render.extinction_law) unless the command line named one.
+bake::BakeSettings forScene(bake::BakeSettings settings, const std::string& law,
+                            const scenes::Scene& scene)
+{
+    settings.extinctionLaw = law.empty() ? scene.render.model.extinctionLaw : law;
+    return settings;
+}
+
+int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& common,
+            const std::string& law, const fs::path& out)
 {
     const auto start = std::chrono::steady_clock::now();
     io::checkWritable(out);  // before the work, not after it
     const scenes::Scene scene = scenes::loadScene(sceneFile);
+    const bake::BakeSettings settings = forScene(common, law, scene);
     if (tree < 0 || std::size_t(tree) >= scene.trees.size()) {
         std::cerr << "bake: " << sceneFile.string() << ": no tree " << tree << " (the scene has "
                   << scene.trees.size() << ")\n";
@@ -79,11 +88,13 @@ fs::path treeFile(const fs::path& dir, std::size_t index)
     return dir / name;
 }
 
-int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& settings, const fs::path& dir)
+int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const std::string& law,
+              const fs::path& dir)
 {
     const auto start = std::chrono::steady_clock::now();
     io::checkWritable(treeFile(dir, 0));
     const scenes::Scene scene = scenes::loadScene(sceneFile);
+    const bake::BakeSettings settings = forScene(common, law, scene);
     const std::size_t n = scene.trees.size();
     Totals totals;
     std::mutex progress;
@@ -111,6 +122,7 @@ int main(int argc, char** argv)
     fs::path sceneFile, out, outDir;
     int tree = 0;
     bake::BakeSettings settings;
+    std::string law;
     // CLI::PositiveNumber would print DBL_MAX in its message.
     const CLI::Validator positive(
         [](std::string& text) -> std::string {
@@ -127,10 +139,10 @@ int main(int argc, char** argv)
         cmd->add_option("--voxel-size", settings.voxelSize_cm, "Voxel size in cm")
             ->required()
             ->check(positive);
-        cmd->add_option("--extinction-law", settings.extinctionLaw,
-                        "How the field stops light (written into the file)")
-            ->check(CLI::IsMember(bake::extinctionLawNames()))
-            ->capture_default_str();
+        cmd->add_option("--extinction-law", law,
+                        "How the field stops light, written into the file (default: the "
+                        "scene's render.extinction_law, fibre unless it says otherwise)")
+            ->check(CLI::IsMember(bake::extinctionLawNames()));
         cmd->add_option("--levels", settings.pyramidLevels,
                         "Density levels at h, 2h, 4h, ... (1: no pyramid)")
             ->default_val(settings.pyramidLevels)
@@ -147,8 +159,8 @@ int main(int argc, char** argv)
 
     return tool::run("bake", app, argc, argv, [&] {
         try {
-            if (*treeCmd) return bakeOne(sceneFile, tree, settings, out);
-            return bakeScene(sceneFile, settings, outDir);
+            if (*treeCmd) return bakeOne(sceneFile, tree, settings, law, out);
+            return bakeScene(sceneFile, settings, law, outDir);
         } catch (...) {
             if (gProgressOpen.exchange(false)) std::fputc('\n', stderr);  // the error's own line
             throw;

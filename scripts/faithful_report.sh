@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# The faithful models against the explicit needles on whole scenes (docs/models.md): three-firs
+# and the paper forest at 320 x 240 with self-shadowing added to their effects, rendered by the
+# geometry method (64 spp, the truth), by the multiscale method with the faithful models (the
+# default) and with --paper. Prints, per render, the foliage coverage (mean of the foliage
+# AOV) and the foliage-weighted luminance (sum of luminance x foliage over sum of foliage).
+#
+#   bash scripts/faithful_report.sh [DIR]     renders into DIR (default: a temporary folder)
+#
+# Takes about a minute on 2 cores. Uses build/bin (build first) and oiiotool.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=${VDBTRACE:-build/bin/vdbtrace}
+[ -x "$bin" ] || { echo "faithful_report: $bin is missing: build first" >&2; exit 2; }
+command -v oiiotool >/dev/null || { echo "faithful_report: oiiotool is missing" >&2; exit 2; }
+out=${1:-$(mktemp -d)}
+mkdir -p "$out"
+/usr/bin/python3 - "$out" <<'PY'
+import json, sys
+for name in ("three-firs", "paper-forest"):
+    scene = json.load(open(f"scenes/{name}.json"))
+    scene["camera"]["resolution"] = [320, 240]
+    scene["effects"] = sorted(set(scene.get("effects", ["diffuse"])) | {"self_shadowing"})
+    json.dump(scene, open(f"{sys.argv[1]}/{name}.json", "w"), indent=1)
+PY
+measure() {
+  local exr=$1 coverage weighted
+  coverage=$(oiiotool "$exr" --ch foliage.Y --printstats | awk '/Stats Avg/ {print $3}')
+  weighted=$(oiiotool "$exr" --ch R,G,B --chsum:weight=0.2126,0.7152,0.0722 "$exr" \
+               --ch foliage.Y --mul --printstats | awk '/Stats Avg/ {print $3}')
+  /usr/bin/python3 -c "print('%.5f %.5f' % ($coverage, $weighted / $coverage))"
+}
+printf '%-14s %-10s %9s %9s %9s %9s\n' scene render coverage vs_truth luminance vs_truth
+for name in three-firs paper-forest; do
+  scene="$out/$name.json"
+  "$bin" render "$scene" --method geometry --samples 64 --out "$out/$name.truth.exr" 2>/dev/null
+  "$bin" render "$scene" --out "$out/$name.faithful.exr" 2>/dev/null
+  "$bin" render "$scene" --paper --out "$out/$name.paper.exr" 2>/dev/null
+  read -r tc tl < <(measure "$out/$name.truth.exr")
+  for render in truth faithful paper; do
+    read -r c l < <(measure "$out/$name.$render.exr")
+    /usr/bin/python3 -c "print('%-14s %-10s %9.5f %+8.1f%% %9.5f %+8.1f%%' % ('$name', '$render', $c, 100 * ($c / $tc - 1), $l, 100 * ($l / $tl - 1)))"
+  done
+done
+echo "faithful_report: images in $out" >&2
