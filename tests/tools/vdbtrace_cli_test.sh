@@ -31,6 +31,27 @@ if command -v oiiotool >/dev/null; then
     oiiotool --info -v "$work/b.exr" | grep -q "level.Y" || fail "EXR lacks the level AOV"
 fi
 
+# The models: faithful by default, --paper as printed, recorded in the stats; a scene naming an
+# unknown one is refused with its key.
+grep -q '"bough_law": "exact"' "$work/b.json" || fail "default bough law not recorded as exact"
+grep -q '"layer_model": "fibre"' "$work/b.json" || fail "default layer model not recorded as fibre"
+"$vdbtrace" render "$src/scenes/bough.json" --paper --out "$work/p.exr" --stats "$work/p.json" 2>"$work/err" \
+    || fail "render --paper failed: $(tail -1 "$work/err")"
+grep -q '"bough_law": "linear"' "$work/p.json" || fail "--paper did not choose the linear law"
+grep -q '"layer_model": "paper"' "$work/p.json" || fail "--paper did not choose the paper's layers"
+"$vdbtrace" render "$src/scenes/bough.json" --paper --layer-model fibre --out "$work/p.exr" --stats "$work/p.json" 2>/dev/null \
+    || fail "render --paper --layer-model fibre failed"
+grep -q '"layer_model": "fibre"' "$work/p.json" || fail "--layer-model did not override --paper"
+/usr/bin/python3 - "$src/scenes/bough.json" "$work/law.json" <<'PY'
+import json, sys
+scene = json.load(open(sys.argv[1]))
+scene.setdefault("render", {})["bough_law"] = "quadratic"
+json.dump(scene, open(sys.argv[2], "w"))
+PY
+expect_error "unknown bough law" 2 "law.json: render.bough_law: unknown bough law 'quadratic' (known: exact, linear)" \
+    -- render "$work/law.json" --out "$work/q.exr"
+[ ! -e "$work/q.exr" ] || fail "a refused scene wrote an image"
+
 # The reference method reads what bake wrote, and refuses a damaged file with one line.
 bake="$(dirname "$vdbtrace")/bake"
 if [ -x "$bake" ]; then
