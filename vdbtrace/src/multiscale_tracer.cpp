@@ -105,9 +105,10 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
     if (level == Level::Cone) {
         // Level 2: each layer as the layer model stops the ray, shaded as its needle there.
         // The bough covers `coverage` of the footprint and its layers lie over one another
-        // within it: together they cover coverage (1 - prod(1 - alpha_i)), which each layer
-        // composited alone with coverage alpha_i would exceed where coverage < 1 (the edge of
-        // the strip). So each layer's share of the bough's coverage is what it composites.
+        // within it: together they cover coverage (1 - prod(1 - alpha_i)), which the layers
+        // composited alone, each of opacity coverage alpha_i, exceed where coverage < 1 (the
+        // edge of the strip). So each layer's share of the bough's coverage is what it
+        // composites.
         mLayerHits.clear();
         mScene.layers->layers(b, ray.origin, ray.direction, tIn, tOut,
                               [&](const LayerHit& hit) { mLayerHits.push_back(hit); });

@@ -90,7 +90,7 @@ struct TreeGrids {
     std::vector<openvdb::FloatGrid::Ptr> densityPyramid;
     double densityScale_per_cm = 0.0;  ///< extinction per cm of density 1
     double voxelSize_cm = 0.5;
-    std::string extinctionLaw = "layer";  ///< the law density was made with, and sigma's
+    std::string extinctionLaw = "fibre";  ///< the law density was made with, and sigma's
 
     /// The grid of a field of kFields, untyped (null if not set).
     openvdb::GridBase::Ptr grid(Field field) const;

@@ -1,7 +1,9 @@
 // Where a line crosses the true cones of a bough (paper section 3.1, errata E12): cone j is the
 // surface g = h - rho cot(phi) = j dh, h along the branch from its base, rho the distance from
-// it. Shared by the multiscale levels 1-2 (the cones a view ray meets) and their
-// self-shadowing (the layers a ray to the light crosses).
+// it. Two ways to walk a line through them: its crossings of each cone (the paper's layer
+// model) and its bands, where it passes each cone's needles (level 1's needle search and the
+// fibre layer model). Shared by the multiscale levels 1-2, their self-shadowing and the exact
+// bough law.
 #pragma once
 
 #include "pine/vdbtrace/traced_scene.h"
