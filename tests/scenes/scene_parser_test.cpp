@@ -178,6 +178,27 @@ TEST(SceneParser, EffectsListedAreTheOnlyOnesOn)
                  s.effects.selfShadowing);
 }
 
+TEST(SceneParser, ModelsAreFaithfulUnlessThePresetOrAKeySaysOtherwise)
+{
+    json j = minimalScene();
+    const ModelChoices faithful = parseScene(j.dump(), "m.json").render.model;
+    EXPECT_EQ(faithful.boughLaw, "exact");
+    EXPECT_EQ(faithful.layerModel, "fibre");
+    EXPECT_EQ(faithful.extinctionLaw, "fibre");
+    j["render"]["preset"] = "paper";
+    const ModelChoices paper = parseScene(j.dump(), "m.json").render.model;
+    EXPECT_EQ(paper.boughLaw, "linear");
+    EXPECT_EQ(paper.layerModel, "paper");
+    EXPECT_EQ(paper.extinctionLaw, "layer");
+    // A key after the preset overrides it alone.
+    j["render"]["layer_model"] = "fibre";
+    const ModelChoices mixed = parseScene(j.dump(), "m.json").render.model;
+    EXPECT_EQ(mixed.boughLaw, "linear");
+    EXPECT_EQ(mixed.layerModel, "fibre");
+    j["render"]["preset"] = "printed";
+    expectError(j, "render.preset", "must be \"faithful\" or \"paper\"");
+}
+
 TEST(SceneParser, ScatterIsSeededInsideItsRegionAndOnTheGround)
 {
     const json j = fullScene();
