@@ -12,6 +12,7 @@
 // chords' passages along the axis over that length, so that the strip covers what the needles
 // cover; what oblique chords meet beyond its ends is put onto it, each cell kept a coverage.
 #include "pine/vdbtrace/bough_law.h"
+#include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -52,7 +53,7 @@ bool chord(const TracedBough& b, const Vec3& d, const Vec3& across, int k, int p
     weight = extent / kChords / glm::length(b.conesEnd_cm - b.base_cm);
     const double far = extent + 25.0 * b.radius_cm;
     o = b.base_cm + at * b.axis + xi * across - far * d;
-    return intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.conesEnd_cm, b.radius_cm, tIn, tOut);
+    return layeredInterval(b, o, d, tIn, tOut);
 }
 
 class ExactBoughLaw final : public BoughLaw {

@@ -31,10 +31,7 @@ public:
                          long ownCone) const override
     {
         double tIn, tOut;
-        if (!intersectCylinder(ConeRay{x, towardsLight, 0.0}, b.base_cm, b.conesEnd_cm,
-                               b.radius_cm, tIn, tOut)) {
-            return 1.0;
-        }
+        if (!layeredInterval(b, x, towardsLight, tIn, tOut)) return 1.0;
         const bool inside = tIn <= 0.0;
         bool first = true;
         double transmittance = 1.0;

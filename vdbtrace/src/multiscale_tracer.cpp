@@ -187,7 +187,7 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     if (level != Level::Bough) {
         // Cones and needles are found along the cone's axis; where the axis misses them the
         // footprint only grazes the bough: shade the volume.
-        if (intersectCylinder(ray, b.base_cm, b.conesEnd_cm, b.radius_cm, tIn, tOut)) {
+        if (layeredInterval(b, ray.origin, ray.direction, tIn, tOut)) {
             addCrossings(ray, index, b, tIn, tOut, c, level);
             return;
         }

@@ -25,10 +25,7 @@ public:
                          long) const override
     {
         double tIn, tOut;
-        if (!intersectCylinder(ConeRay{x, towardsLight, 0.0}, b.base_cm, b.conesEnd_cm,
-                               b.radius_cm, tIn, tOut)) {
-            return 1.0;
-        }
+        if (!layeredInterval(b, x, towardsLight, tIn, tOut)) return 1.0;
         int count = 0;
         forEachConeCrossing(b, x, towardsLight, std::max(tIn, 1e-6), tOut,
                             [&count](long, double) { ++count; });

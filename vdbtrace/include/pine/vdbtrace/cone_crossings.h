@@ -29,6 +29,14 @@ inline double coneHeight(const TracedBough& b, double cotPhi, const Vec3& x, dou
     return h - d * cotPhi;
 }
 
+/// The interval of o + t d inside the region bough b's cones fill, as levels 1-2 and the layer
+/// models see it: the cylinder of radius R from the base to the cones' end. False if none.
+inline bool layeredInterval(const TracedBough& b, const Vec3& o, const Vec3& d, double& tIn,
+                            double& tOut)
+{
+    return intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.conesEnd_cm, b.radius_cm, tIn, tOut);
+}
+
 /// Calls visit(j, t) for every crossing of cone j in [0, floor(length / dh)] by the line
 /// o + t d, t in [tIn, tOut], in order: the march moves g by at most dh / 4 a step (|dg/dt|
 /// <= 1 + cot(phi)) and places each crossing by linear interpolation within its step.
