@@ -50,11 +50,9 @@ struct LongBough {
         d.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
         d.spec.needles.coneSpacing_cm = 0.9;
         d.seed = seed;
-        const EffectsPlan plan = EffectsPlan::from(scene.effects);
-        traced.boughs.push_back(makeTracedBough(d, scene.camera.position_cm, traced.lights,
-                                                boughLaw(model.boughLaw),
-                                                layerModel(model.layerModel),
-                                                {plan.selfShadowing, plan.shadowRays}));
+        traced.boughs.push_back(makeTracedBough(
+            d, scene.camera.position_cm, traced.lights, boughLaw(model.boughLaw),
+            layerModel(model.layerModel), BoughLawNeeds::from(EffectsPlan::from(scene.effects))));
         const TracedBough& b = traced.boughs.back();
         traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
     }
@@ -144,7 +142,7 @@ struct RecedingBoughs {
   "effects": ["diffuse", "self_shadowing"]})",
                                    "receding.json");
         traced = buildTracedScene(scene);
-        const EffectsPlan plan = EffectsPlan::from(scene.effects);
+        const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
         for (int k = 0; k < 2; ++k) {
             BoughDescription d;
             d.spec.base_cm = Vec3(-150.0, 0.0, 7.5 - 15.0 * k);
@@ -154,7 +152,7 @@ struct RecedingBoughs {
             d.seed = 3 + k;
             traced.boughs.push_back(makeTracedBough(
                 d, scene.camera.position_cm, traced.lights, boughLaw(scene.render.model.boughLaw),
-                *traced.layers, {plan.selfShadowing, plan.shadowRays}));
+                *traced.layers, needs));
         }
         std::vector<Aabb> boxes;
         for (const TracedBough& b : traced.boughs) {

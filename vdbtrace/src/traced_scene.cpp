@@ -145,8 +145,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
     const LayerModel& layers = chosen("layer_model", [&]() -> const LayerModel& {
         return layerModel(model.layerModel);
     });
-    const EffectsPlan plan = EffectsPlan::from(scene.effects);
-    const BoughLawNeeds needs{plan.selfShadowing, plan.shadowRays};
+    const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
     TracedScene out;
     out.scene = &scene;
     out.layers = &layers;

@@ -6,6 +6,7 @@
 // whole strip, the exact law a function of the chord's offset.
 #pragma once
 
+#include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/geometry.h"
 #include "pine/vdbtrace/strip_profile.h"
 
@@ -44,6 +45,11 @@ struct BoughLightTransfer {
 struct BoughLawNeeds {
     bool transfer = true;        ///< self-shadowing: each light's transfer
     bool shadowOpacity = true;   ///< shadows: each light's opacity
+    /// What a render of the effects `plan` reads.
+    static BoughLawNeeds from(const EffectsPlan& plan)
+    {
+        return {plan.selfShadowing, plan.shadowRays};
+    }
 };
 
 /// A bough under a law, for one camera position and the scene's lights.
