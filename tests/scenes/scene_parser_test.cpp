@@ -185,11 +185,13 @@ TEST(SceneParser, ModelsAreFaithfulUnlessThePresetOrAKeySaysOtherwise)
     EXPECT_EQ(faithful.boughLaw, "exact");
     EXPECT_EQ(faithful.layerModel, "fibre");
     EXPECT_EQ(faithful.extinctionLaw, "fibre");
+    EXPECT_EQ(faithful.shadowOrigin, "needles");
     j["render"]["preset"] = "paper";
     const ModelChoices paper = parseScene(j.dump(), "m.json").render.model;
     EXPECT_EQ(paper.boughLaw, "linear");
     EXPECT_EQ(paper.layerModel, "paper");
     EXPECT_EQ(paper.extinctionLaw, "layer");
+    EXPECT_EQ(paper.shadowOrigin, "axis");
     // A key after the preset overrides it alone.
     j["render"]["layer_model"] = "fibre";
     const ModelChoices mixed = parseScene(j.dump(), "m.json").render.model;

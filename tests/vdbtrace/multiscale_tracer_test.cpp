@@ -169,8 +169,10 @@ public:
         BoughShading s;
         s.alpha = {StripProfile::constant(0.3), StripProfile::constant(0.2)};
         for (std::size_t i = 0; i < towardsLights.size(); ++i) {
-            s.lights.push_back({{StripProfile::constant(0.1), StripProfile::constant(0.05)},
-                                StripProfile::constant(0.5)});
+            BoughLightTransfer light;
+            light.transfer = {StripProfile::constant(0.1), StripProfile::constant(0.05)};
+            light.opacityFromLight = StripProfile::constant(0.5);
+            s.lights.push_back(light);
         }
         return s;
     }
@@ -222,6 +224,18 @@ TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("fir.json: render.layer_model: unknown layer model "
                                              "'foam' (known: fibre, paper)"),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(shadowOriginNames().front(), scenes::ModelChoices{}.shadowOrigin);
+    scene.render.model = {};
+    scene.render.model.shadowOrigin = "sun";
+    try {
+        buildTracedScene(scene);
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("fir.json: render.shadow_origin: unknown shadow "
+                                             "origin 'sun' (known: needles, axis)"),
                   std::string::npos)
             << e.what();
     }

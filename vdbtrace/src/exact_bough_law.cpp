@@ -12,6 +12,8 @@
 // chords' passages along the axis over that length, so that the strip covers what the needles
 // cover; what oblique chords meet beyond its ends is put onto it, each cell kept a coverage.
 #include "pine/vdbtrace/bough_law.h"
+
+#include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/traced_scene.h"
@@ -29,17 +31,26 @@ namespace {
 // through the plane of the axis and the chord maps cones onto cones), so opacities are
 // computed on half the cells; transfers are not even (the light is on one side).
 constexpr int kCells = 12;
-constexpr int kChords = 4;
+constexpr int kChords = 10;
+constexpr int kEndChords = 3;  ///< of kChords at each end of a bough with an interior
 // Below this transmittance a chord stops: nothing behind shows.
 constexpr double kOpaque = 1e-4;
 
 double cellCentre(int k) { return -1.0 + (k + 0.5) * 2.0 / kCells; }
 
 // Chord p of cell k along d at signed offset xi along `across` (orthogonal to the axis and to
-// d): it passes the axis closest at s along it, s spread evenly over every passage whose chord
-// meets the layered cylinder (shifted by a different fraction per cell, so that the cells do
-// not share where the cones fall). Its interval inside the cylinder, false if it misses it;
-// `weight` is the share of the strip's length it stands for.
+// d): it passes the axis closest at `at` along it. Its interval inside the cylinder, false if
+// it misses it; `weight` is the share of the strip's length it stands for.
+//
+// The passages that meet the layered cylinder run from -reach to the cones' end + reach. Near
+// each end (within the cones' reach l cos(phi) and the chord's own reach) a chord meets fewer
+// cones; between them, on a long bough, its layers repeat with the cone spacing dh. So each
+// end gets kEndChords chords spread evenly over it, and the interior the rest, stratified over
+// the phase of one cone spacing at its middle, each weighted by the length it stands for: four
+// chords spread evenly over a 200 cm bough put a quarter of a cell's weight wherever the
+// last one fell, an end or an arbitrary phase (a cell 10% off the needles). A bough too short
+// for an interior spreads all its chords evenly. Each cell's chords are shifted by a
+// different fraction, so that the cells do not share where the cones fall.
 bool chord(const TracedBough& b, const Vec3& d, const Vec3& across, int k, int p, Vec3& o,
            double& tIn, double& tOut, double& weight)
 {
@@ -47,11 +58,29 @@ bool chord(const TracedBough& b, const Vec3& d, const Vec3& across, int k, int p
     const double c = glm::dot(d, b.axis), s = std::sqrt(std::max(0.0, 1.0 - c * c));
     const double cotangent = s > 0.05 ? std::abs(c) / s : 20.0;
     const double reach = std::sqrt(std::max(0.0, b.radius_cm * b.radius_cm - xi * xi)) * cotangent;
-    const double extent = glm::length(b.conesEnd_cm - b.base_cm) + 2.0 * reach;
+    const double cones = glm::length(b.conesEnd_cm - b.base_cm);
+    const double apexes = glm::length(b.tip_cm - b.base_cm);
+    const double dh = b.geometry.coneSpacing_cm;
     const double shift = std::fmod(0.5 + 0.6180339887498949 * k, 1.0);
-    const double at = -reach + (p + shift) * extent / kChords;
-    weight = extent / kChords / glm::length(b.conesEnd_cm - b.base_cm);
-    const double far = extent + 25.0 * b.radius_cm;
+    const double first = -reach, last = cones + reach;
+    const double interiorFrom = (cones - apexes) + reach, interiorTo = apexes - reach;
+    double at, length;
+    if (interiorTo - interiorFrom < 2.0 * dh) {
+        length = (last - first) / kChords;
+        at = first + (p + shift) * length;
+    } else if (p < 2 * kEndChords) {
+        const bool base = p < kEndChords;
+        const double from = base ? first : interiorTo, to = base ? interiorFrom : last;
+        length = (to - from) / kEndChords;
+        at = from + (p % kEndChords + shift) * length;
+    } else {
+        constexpr int interior = kChords - 2 * kEndChords;
+        length = (interiorTo - interiorFrom) / interior;
+        const double middle = 0.5 * (interiorFrom + interiorTo);
+        at = middle + dh * ((p - 2 * kEndChords + shift) / interior - 0.5);
+    }
+    weight = length / cones;
+    const double far = last - first + 25.0 * b.radius_cm;
     o = b.base_cm + at * b.axis + xi * across - far * d;
     return layeredInterval(b, o, d, tIn, tOut);
 }
@@ -64,12 +93,22 @@ public:
     {
         BoughShading out;
         out.rear = RearComposite::Share;
+        out.shadesNeedles = true;
         const Vec3 d = -V;
+        const double phi = b.geometry.cone.aperture_rad;
+        const double cotPhi = 1.0 / std::tan(phi), sinPhi = std::sin(phi), cosPhi = std::cos(phi);
         const std::size_t lights = towardsLights.size();
-        std::vector<double> front(kCells, 0.0), rear(kCells, 0.0);
-        std::vector<std::vector<double>> litFront(lights, front), litRear(lights, front);
+        // Per half (0 front, 1 rear) and cell: the opacity; per light, what is lit (the
+        // transfer) and what it reflects.
+        using Cells = std::vector<double>;
+        Cells alpha[2] = {Cells(kCells, 0.0), Cells(kCells, 0.0)};
+        std::vector<Cells> lit[2], diffuse[2], specular[2];
+        for (int h = 0; h < 2; ++h) {
+            lit[h] = diffuse[h] = specular[h] = std::vector<Cells>(lights, Cells(kCells, 0.0));
+        }
         for (int k = 0; k < kCells; ++k) {
-            if (!needs.transfer && k >= kCells / 2) continue;
+            // Opacities are even in the offset: with no light to shade, half the cells do.
+            if (lights == 0 && k >= kCells / 2) continue;
             for (int p = 0; p < kChords; ++p) {
                 Vec3 o;
                 double tIn, tOut, weight;
@@ -80,43 +119,58 @@ public:
                     if (T < kOpaque) return;
                     const double share = T * hit.opacity;  // what this layer shows
                     T *= 1.0 - hit.opacity;
-                    const bool isFront = hit.t < tMid;
-                    (isFront ? front : rear)[k] += share * weight;
-                    if (!needs.transfer || share <= 0.0) return;
+                    const int half = hit.t < tMid ? 0 : 1;
+                    alpha[half][k] += share * weight;
+                    if (share <= 0.0) return;
                     const Vec3 x = o + hit.t * d;
+                    double rho;
+                    Vec3 radial;
+                    coneHeight(b, cotPhi, x, &rho, &radial);
+                    const Vec3 needle = cosPhi * b.axis + sinPhi * radial;  // as at level 2
                     for (std::size_t i = 0; i < lights; ++i) {
-                        const double lit =
-                            share * layers.transmittance(b, x, towardsLights[i], hit.cone);
-                        (isFront ? litFront : litRear)[i][k] += lit * weight;
+                        const Vec3& L = towardsLights[i];
+                        const double seen =
+                            share * weight *
+                            (needs.transfer ? layers.transmittance(b, x, L, hit.cone) : 1.0);
+                        lit[half][i][k] += seen;
+                        if (needs.diffuse) {
+                            diffuse[half][i][k] += seen * analytic::needleDiffuse(needle, L, V);
+                        }
+                        if (needs.specular) {
+                            specular[half][i][k] +=
+                                seen * analytic::needleSpecular(needle, L, V, b.exponent);
+                        }
                     }
                 });
             }
         }
-        for (int k = kCells / 2; k < kCells; ++k) {
-            // The opacity from the mirrored cell whether or not the transfer was walked here,
-            // so that the coverage is the same with self-shadowing or without.
-            front[k] = front[kCells - 1 - k];
-            rear[k] = rear[kCells - 1 - k];
+        for (int k = kCells / 2; k < kCells && lights == 0; ++k) {
+            alpha[0][k] = alpha[0][kCells - 1 - k];
+            alpha[1][k] = alpha[1][kCells - 1 - k];
         }
         for (int k = 0; k < kCells; ++k) {
             // Oblique chords beyond the strip's ends, put onto it, may add up past 1.
-            const double total = front[k] + rear[k];
-            if (total > 1.0) {
+            const double total = alpha[0][k] + alpha[1][k];
+            if (!(total > 1.0)) continue;
+            for (int h = 0; h < 2; ++h) {
+                alpha[h][k] /= total;
                 for (std::size_t i = 0; i < lights; ++i) {
-                    litFront[i][k] /= total;
-                    litRear[i][k] /= total;
+                    lit[h][i][k] /= total;
+                    diffuse[h][i][k] /= total;
+                    specular[h][i][k] /= total;
                 }
-                front[k] /= total;
-                rear[k] /= total;
             }
         }
-        out.alpha = {StripProfile::sampled(front), StripProfile::sampled(rear)};
+        const auto profiles = [](const Cells& front, const Cells& rear) {
+            return FrontRearProfile{StripProfile::sampled(front), StripProfile::sampled(rear)};
+        };
+        out.alpha = profiles(alpha[0], alpha[1]);
         out.stripToConesEnd = true;
         for (std::size_t i = 0; i < lights; ++i) {
             BoughLightTransfer light;
-            light.transfer = needs.transfer ? FrontRearProfile{StripProfile::sampled(litFront[i]),
-                                                               StripProfile::sampled(litRear[i])}
-                                            : out.alpha;
+            light.transfer = profiles(lit[0][i], lit[1][i]);
+            light.diffuse = profiles(diffuse[0][i], diffuse[1][i]);
+            light.specular = profiles(specular[0][i], specular[1][i]);
             if (needs.shadowOpacity) {
                 light.opacityFromLight = opacityAlong(b, -towardsLights[i], layers);
             }

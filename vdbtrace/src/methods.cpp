@@ -16,7 +16,8 @@ RenderResult multiscale(const TracedScene& scene, const MethodSettings& s,
 nlohmann::json describeMultiscale(const scenes::Scene& scene, const MethodSettings&)
 {
     return {{"bough_law", scene.render.model.boughLaw},
-            {"layer_model", scene.render.model.layerModel}};
+            {"layer_model", scene.render.model.layerModel},
+            {"shadow_origin", scene.render.model.shadowOrigin}};
 }
 
 RenderResult reference(const TracedScene& scene, const MethodSettings& s,

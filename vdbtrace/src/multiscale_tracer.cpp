@@ -36,18 +36,32 @@ public:
 
 private:
     double transmittance(const Vec3& x, std::size_t light, double footprint_cm,
-                         std::size_t self) override
+                         std::size_t self, const ShadowSamples* samples) override
     {
-        return shadowConeTransmittance(mScene, x, light, footprint_cm, self, true);
+        return shadowConeTransmittance(mScene, x, light, footprint_cm, self, true, samples);
     }
     void addBough(const ConeRay& ray, std::size_t index);
     void addCrossings(const ConeRay& ray, std::size_t index, const TracedBough& b, double tIn,
                       double tOut, double coverage, Level level);
-    // A needle of cone `cone` at x, its light through the bough's other layers under the
-    // layer model (section 6's self-shadowing at levels 1-2, counted, not approximated).
-    void shadeNeedle(const TracedBough& b, long cone, const Vec3& needle, const Vec3& x,
-                     const Vec3& V, double alpha, double t, int level,
-                     const std::vector<Incident>& light);
+    // A needle of cone `cone` the ray meets at depth t, of which the pixel sees alpha.
+    struct NeedleHit {
+        long cone;
+        Vec3 needle;
+        double t, alpha;
+    };
+    // Shades mNeedleHits (levels 1-2): each needle's light through the bough's other layers
+    // under the layer model (section 6's self-shadowing, counted, not approximated) and
+    // through the scene from where the needles lie.
+    // The bough's cones span [tIn, tOut] along the ray.
+    void shadeNeedles(const ConeRay& ray, std::size_t index, const TracedBough& b, double tIn,
+                      double tOut, int level);
+    // Light `light`'s transmittance through the scene to the needles of bough `index` that
+    // reflect it, at depths mDepths along the ray with the weight of what each reflects to the
+    // pixel: one shadow cone from depth tRef holding them all, each occluder read where each
+    // one's shadow line passes it (ShadowSamples), so that an occluding bough is averaged over
+    // where the needles lie, not read on one line (the explicit needles send a shadow ray from
+    // each).
+    double shadowOf(const ConeRay& ray, std::size_t index, std::size_t light, double tRef);
 
     const TracedScene& mScene;
     const EffectsPlan& mPlan;
@@ -58,32 +72,93 @@ private:
     std::vector<Fragment> mFragments;
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
+    std::vector<NeedleHit> mNeedleHits;               ///< a bough's needles on this ray
+    std::vector<std::size_t> mByDepth;                ///< their indices, front to back
+    std::vector<double> mSelf;       ///< their self-shadowing, hit-major, one per light
+    std::vector<Incident> mLight;    ///< each light at the bough being shaded
+    std::vector<ShadowSamples::Point> mDepths;  ///< (depth along the ray, weight): shadowOf
+    ShadowSamples mShadowSamples;
 };
 
-void MultiscaleRayTracer::shadeNeedle(const TracedBough& b, long cone, const Vec3& needle,
-                                      const Vec3& x, const Vec3& V, double alpha, double t,
-                                      int level, const std::vector<Incident>& light)
+double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std::size_t light,
+                                     double tRef)
 {
-    Fragment f{t, alpha, Vec3(0.0), Vec3(0.0), level, true};
-    for (const Incident& l : light) {
-        double self = 1.0;
-        if (mPlan.selfShadowing) {
-            ++mStats.selfShadowEvaluations;
-            self = mScene.layers->transmittance(b, x, l.towards, cone);
-        }
-        const Vec3 E = l.irradiance * self;
-        if (mPlan.diffuse) {
-            f.diffuse +=
-                alpha * b.needleAlbedo / kPi * E * analytic::needleDiffuse(needle, l.towards, V);
-            ++mStats.diffuseEvaluations;
-        }
-        if (mPlan.specular) {
-            f.specular += alpha * b.specularWeight * E *
-                          analytic::needleSpecular(needle, l.towards, V, b.exponent);
-            ++mStats.specularEvaluations;
+    const Vec3& L = mLight[light].towards;
+    const Vec3 across = ray.direction - glm::dot(ray.direction, L) * L;
+    const double stretch = glm::length(across);  // of depth into offset across the light
+    mShadowSamples.across = stretch > 1e-9 ? across / stretch : Vec3(0.0);
+    mShadowSamples.points.clear();
+    for (const ShadowSamples::Point& d : mDepths) {
+        mShadowSamples.points.push_back({(d.offset_cm - tRef) * stretch, d.weight});
+    }
+    return mSurfaces.shadow(light, ray.origin + tRef * ray.direction, ray.width(tRef), index,
+                            &mShadowSamples);
+}
+
+void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
+                                       const TracedBough& b, double tIn, double tOut, int level)
+{
+    if (mNeedleHits.empty()) return;
+    const std::size_t lights = mScene.lights.size(), hits = mNeedleHits.size();
+    const double tRef = 0.5 * (tIn + tOut);
+    mLight.resize(lights);
+    for (std::size_t i = 0; i < lights; ++i) {
+        mLight[i] = mSurfaces.unshadowed(i, ray.origin + tRef * ray.direction);
+    }
+    mSelf.assign(hits * lights, 1.0);
+    if (mPlan.selfShadowing) {
+        for (std::size_t h = 0; h < hits; ++h) {
+            const Vec3 x = ray.origin + mNeedleHits[h].t * ray.direction;
+            for (std::size_t i = 0; i < lights; ++i) {
+                ++mStats.selfShadowEvaluations;
+                mSelf[h * lights + i] =
+                    mScene.layers->transmittance(b, x, mLight[i].towards, mNeedleHits[h].cone);
+            }
         }
     }
-    mFragments.push_back(f);
+    if (mPlan.shadowRays && !mScene.shadowsFromNeedles) {
+        for (std::size_t i = 0; i < lights; ++i) {
+            mLight[i].irradiance *= mSurfaces.shadow(i, ray.origin + tRef * ray.direction,
+                                                     ray.width(tRef), index);
+        }
+    } else if (mPlan.shadowRays) {
+        // The hits front to back; the fragments keep the order they were found in.
+        mByDepth.resize(hits);
+        for (std::size_t h = 0; h < hits; ++h) mByDepth[h] = h;
+        std::sort(mByDepth.begin(), mByDepth.end(), [&](std::size_t x, std::size_t y) {
+            return mNeedleHits[x].t < mNeedleHits[y].t;
+        });
+        for (std::size_t i = 0; i < lights; ++i) {
+            mDepths.clear();
+            double through = 1.0;  // of the footprint, past this bough's needles in front
+            for (const std::size_t h : mByDepth) {
+                const NeedleHit& n = mNeedleHits[h];
+                mDepths.push_back({n.t, through * n.alpha * mSelf[h * lights + i]});
+                through *= 1.0 - n.alpha;
+            }
+            mLight[i].irradiance *= shadowOf(ray, index, i, tRef);
+        }
+    }
+    const Vec3 V = -ray.direction;
+    for (std::size_t h = 0; h < hits; ++h) {
+        const NeedleHit& n = mNeedleHits[h];
+        Fragment f{n.t, n.alpha, Vec3(0.0), Vec3(0.0), level, true};
+        for (std::size_t i = 0; i < lights; ++i) {
+            const Vec3 E = mLight[i].irradiance * mSelf[h * lights + i];
+            const Vec3& L = mLight[i].towards;
+            if (mPlan.diffuse) {
+                f.diffuse +=
+                    n.alpha * b.needleAlbedo / kPi * E * analytic::needleDiffuse(n.needle, L, V);
+                ++mStats.diffuseEvaluations;
+            }
+            if (mPlan.specular) {
+                f.specular += n.alpha * b.specularWeight * E *
+                              analytic::needleSpecular(n.needle, L, V, b.exponent);
+                ++mStats.specularEvaluations;
+            }
+        }
+        mFragments.push_back(f);
+    }
 }
 
 void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
@@ -92,10 +167,7 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
 {
     const double phi = b.geometry.cone.aperture_rad;
     const double cotPhi = 1.0 / std::tan(phi), sinPhi = std::sin(phi), cosPhi = std::cos(phi);
-    const Vec3 V = -ray.direction;
-    const Vec3 mid = ray.origin + 0.5 * (tIn + tOut) * ray.direction;
-    const std::vector<Incident>& light = mSurfaces.lightAt(mid, ray.width(0.5 * (tIn + tOut)),
-                                                           index);
+    mNeedleHits.clear();
     // The same needles as the explicit-needle ground truth (needle_layout.h).
     const NeedleLayout layout(b);
     const Vec3 e1 = layout.e1(), e2 = layout.e2();
@@ -127,10 +199,9 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
                 alpha = covered < 1.0 ? share / (1.0 - covered) : 0.0;
                 covered += share;
             }
-            const Vec3 needle = cosPhi * b.axis + sinPhi * radial;
-            shadeNeedle(b, hit.cone, needle, ray.origin + hit.t * ray.direction, V, alpha,
-                        hit.t, 2, light);
+            mNeedleHits.push_back({hit.cone, cosPhi * b.axis + sinPhi * radial, hit.t, alpha});
         }
+        shadeNeedles(ray, index, b, tIn, tOut, 2);
         return;
     }
     // Level 1: the needles of each cone the ray passes (cone_crossings.h's bands: also where it
@@ -163,10 +234,11 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
             const double c = stripCoverage(p.gap, r, ray.width(p.t));
             if (c <= 0.0) continue;
             ++mStats.needleHits;
-            shadeNeedle(b, j, needle, ray.origin + p.t * ray.direction, V, c, p.t, 1, light);
+            mNeedleHits.push_back({j, needle, p.t, c});
         }
         return true;
     });
+    shadeNeedles(ray, index, b, tIn, tOut, 1);
 }
 
 void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
@@ -203,7 +275,6 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     // half at the middle, so that the branch inside sorts between them. Each profile is read
     // over the footprint at the chord's signed offset from the axis.
     ++mStats.boughHits;
-    const Vec3 passage = ray.origin + p.t * ray.direction;
     const double R = b.radius_cm;
     const double frontAlpha = b.alpha.front.overFootprint(xi, R, w);
     // What the rear's share is divided by to composite behind the front (bough_law.h).
@@ -212,25 +283,53 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     const auto rearPart = [&](const StripProfile& profile) {
         return behindFront > 1e-9 ? profile.overFootprint(xi, R, w) / behindFront : 0.0;
     };
-    const std::vector<Incident>& light = mSurfaces.lightAt(passage, w, index);
+    const double tMid = 0.5 * (tIn + tOut);
     Fragment front{tIn, frontAlpha, Vec3(0.0), Vec3(0.0), 3, true};
-    Fragment rear{0.5 * (tIn + tOut), rearPart(b.alpha.rear), Vec3(0.0), Vec3(0.0), 3, true};
-    for (std::size_t i = 0; i < light.size(); ++i) {
+    Fragment rear{tMid, rearPart(b.alpha.rear), Vec3(0.0), Vec3(0.0), 3, true};
+    // The light at the chord's middle, or with shadow_origin "axis" where the ray passes the
+    // axis.
+    const double tLight = mScene.shadowsFromNeedles ? tMid : p.t;
+    mLight.resize(mScene.lights.size());
+    for (std::size_t i = 0; i < mLight.size(); ++i) {
         const BoughLighting& lit = b.lighting[i];
-        const Vec3& E = light[i].irradiance;
+        mLight[i] = mSurfaces.unshadowed(i, ray.origin + tLight * ray.direction);
         // Without self-shadowing the whole opacity reflects; with it, the law's transfer.
         const FrontRearProfile& transfer = mPlan.selfShadowing ? lit.transfer : b.alpha;
         const double tf = transfer.front.overFootprint(xi, R, w);
         const double tr = rearPart(transfer.rear);
         mStats.selfShadowEvaluations += mPlan.selfShadowing ? 2 : 0;
+        if (mPlan.shadowRays && !mScene.shadowsFromNeedles) {
+            mLight[i].irradiance *= mSurfaces.shadow(i, ray.origin + p.t * ray.direction, w, index);
+        } else if (mPlan.shadowRays) {
+            // Each half's needles that reflect the light lie along its half of the chord:
+            // three points at the centres of its thirds.
+            mDepths.clear();
+            for (int k = 0; k < 3; ++k) {
+                const double u = (k + 0.5) / 3.0;
+                mDepths.push_back({tIn + u * (tMid - tIn), tf / 3.0});
+                mDepths.push_back({tMid + u * (tOut - tMid), (1.0 - front.alpha) * tr / 3.0});
+            }
+            mLight[i].irradiance *= shadowOf(ray, index, i, tMid);
+        }
+        const Vec3& E = mLight[i].irradiance;
+        // What each half reflects: the law's sum over its needles, or (the paper's laws) the
+        // transfer times the face's mean reflectance I^cyl (section 6.6).
+        const auto reflected = [&](const FrontRearProfile& perNeedle, double frontFace,
+                                   double rearFace, double& f, double& r) {
+            f = b.shadesNeedles ? perNeedle.front.overFootprint(xi, R, w) : tf * frontFace;
+            r = b.shadesNeedles ? rearPart(perNeedle.rear) : tr * rearFace;
+        };
+        double f, r;
         if (mPlan.diffuse) {
-            front.diffuse += tf * lit.front.diffuse * b.needleAlbedo / kPi * E;
-            rear.diffuse += tr * lit.rear.diffuse * b.needleAlbedo / kPi * E;
+            reflected(lit.diffuse, lit.front.diffuse, lit.rear.diffuse, f, r);
+            front.diffuse += f * b.needleAlbedo / kPi * E;
+            rear.diffuse += r * b.needleAlbedo / kPi * E;
             mStats.diffuseEvaluations += 2;
         }
         if (mPlan.specular) {
-            front.specular += tf * lit.front.specular * b.specularWeight * E;
-            rear.specular += tr * lit.rear.specular * b.specularWeight * E;
+            reflected(lit.specular, lit.front.specular, lit.rear.specular, f, r);
+            front.specular += f * b.specularWeight * E;
+            rear.specular += r * b.specularWeight * E;
             mStats.specularEvaluations += 2;
         }
     }

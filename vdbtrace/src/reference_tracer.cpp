@@ -178,7 +178,7 @@ public:
 
 private:
     double transmittance(const Vec3& x, std::size_t light, double footprint_cm,
-                         std::size_t self) override
+                         std::size_t self, const ShadowSamples*) override
     {
         return mMethod.transmittance(mThread, x, light, footprint_cm, self);
     }

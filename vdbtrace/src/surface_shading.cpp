@@ -10,30 +10,72 @@
 namespace pine::vdbtrace {
 
 double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::size_t light,
-                               double footprint_cm, std::size_t self, bool throughBoughs)
+                               double footprint_cm, std::size_t self, bool throughBoughs,
+                               const ShadowSamples* samples)
 {
+    // One point at x when no samples are given.
+    static const ShadowSamples kOrigin{Vec3(0.0), {{0.0, 1.0}}};
+    const ShadowSamples& at = samples && !samples->points.empty() ? *samples : kOrigin;
+    double reach = 0.0;  // of the points from x
+    for (const ShadowSamples::Point& q : at.points) reach = std::max(reach, std::abs(q.offset_cm));
     double tMax;
-    const ConeRay ray = scene.lights[light].shadowCone(x, footprint_cm, tMax);
-    double transmittance = 1.0;
+    const ConeRay ray =
+        scene.lights[light].shadowCone(x, footprint_cm + 2.0 * reach, tMax);
+    // Each point reads the occluders with the footprint's own width.
+    const double pointWidth = reach > 0.0 ? footprint_cm / (footprint_cm + 2.0 * reach) : 1.0;
+    // Each point's transmittance so far.
+    thread_local std::vector<double> T;
+    T.assign(at.points.size(), 1.0);
+    bool dark = false;
     scene.bvh.query(ray, tMax, [&](std::uint32_t index) {
-        if (index == self || transmittance < 1e-4) return;
+        if (index == self || dark) return;
         const bool branch = scene.isBranch(index);
         if (!branch && !throughBoughs) return;
+        const Vec3 a = branch ? scene.branches[index].base_cm : scene.bough(index).base_cm;
+        const Vec3 b = branch ? scene.branches[index].tip_cm : scene.bough(index).stripEnd_cm;
         Passage p;
-        if (branch) {
-            const TracedBranch& br = scene.branches[index];
-            if (closestPassage(ray, br.base_cm, br.tip_cm, p) && p.t < tMax) {
-                transmittance *= 1.0 - stripCoverage(p.gap, br.radius_cm, ray.width(p.t));
-            }
-        } else {
-            const TracedBough& b = scene.bough(index);
-            if (closestPassage(ray, b.base_cm, b.stripEnd_cm, p) && p.t < tMax) {
-                transmittance *= 1.0 - b.lighting[light].opacityFromLight.overFootprint(
-                                           p.gap, b.radius_cm, ray.width(p.t));
-            }
+        if (!closestPassage(ray, a, b, p) || !(p.t < tMax)) return;
+        // The points' lines pass the occluder shifted along its strip by their offsets (scaled
+        // towards a point light), each read with the footprint's own width.
+        const Vec3 n = stripAcross(glm::normalize(b - a), ray.direction);
+        const Vec3 c = ray.origin + p.t * ray.direction;
+        const double gap = reach > 0.0 ? glm::dot(c - (a + p.s * (b - a)), n) : p.gap;
+        const double scale = scene.lights[light].directional ? 1.0 : p.t / tMax;
+        const double along = glm::dot(at.across, n) * scale;
+        const double w = pointWidth * ray.width(p.t);
+        dark = true;
+        for (std::size_t k = 0; k < T.size(); ++k) {
+            const double g = gap + along * at.points[k].offset_cm;
+            const double alpha =
+                branch ? stripCoverage(g, scene.branches[index].radius_cm, w)
+                       : scene.bough(index).lighting[light].opacityFromLight.overFootprint(
+                             g, scene.bough(index).radius_cm, w);
+            T[k] *= 1.0 - alpha;
+            dark = dark && T[k] < 1e-4;
         }
     });
-    return transmittance;
+    double sum = 0.0, weight = 0.0;
+    for (std::size_t k = 0; k < T.size(); ++k) {
+        sum += at.points[k].weight * T[k];
+        weight += at.points[k].weight;
+    }
+    return weight > 0.0 ? sum / weight : 1.0;
+}
+
+Incident SurfaceShading::unshadowed(std::size_t light, const Vec3& x) const
+{
+    Incident in;
+    double distance;
+    mScene.lights[light].at(x, in.towards, distance, in.irradiance);
+    return in;
+}
+
+double SurfaceShading::shadow(std::size_t light, const Vec3& x, double footprint_cm,
+                              std::size_t self, const ShadowSamples* samples)
+{
+    if (!mPlan.shadowRays) return 1.0;
+    ++mStats.shadowRays;
+    return mTransport.transmittance(x, light, footprint_cm, self, samples);
 }
 
 const std::vector<Incident>& SurfaceShading::lightAt(const Vec3& x, double footprint_cm,
@@ -41,11 +83,8 @@ const std::vector<Incident>& SurfaceShading::lightAt(const Vec3& x, double footp
 {
     mIncident.resize(mScene.lights.size());
     for (std::size_t i = 0; i < mScene.lights.size(); ++i) {
-        double distance;
-        mScene.lights[i].at(x, mIncident[i].towards, distance, mIncident[i].irradiance);
-        if (!mPlan.shadowRays) continue;
-        ++mStats.shadowRays;
-        mIncident[i].irradiance *= mTransport.transmittance(x, i, footprint_cm, self);
+        mIncident[i] = unshadowed(i, x);
+        mIncident[i].irradiance *= shadow(i, x, footprint_cm, self, nullptr);
     }
     return mIncident;
 }

@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -115,6 +116,7 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
     b.alpha = shading.alpha;
     b.rearComposite = shading.rear;
     b.stripEnd_cm = shading.stripToConesEnd ? b.conesEnd_cm : b.tip_cm;
+    b.shadesNeedles = shading.shadesNeedles;
     for (std::size_t i = 0; i < lights.size(); ++i) {
         const auto sums = analytic::coneSums(
             cone, analytic::coneIntegrals(cone.aperture_rad, b.axis, towards[i], V, b.exponent),
@@ -123,11 +125,15 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
         lit.front = analytic::meanReflectance(sums.front);
         lit.rear = analytic::meanReflectance(sums.rear);
         lit.transfer = shading.lights[i].transfer;
+        lit.diffuse = shading.lights[i].diffuse;
+        lit.specular = shading.lights[i].specular;
         lit.opacityFromLight = shading.lights[i].opacityFromLight;
         b.lighting.push_back(lit);
     }
     return b;
 }
+
+std::vector<std::string> shadowOriginNames() { return {"needles", "axis"}; }
 
 TracedScene buildTracedScene(const scenes::Scene& scene)
 {
@@ -145,10 +151,19 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
     const LayerModel& layers = chosen("layer_model", [&]() -> const LayerModel& {
         return layerModel(model.layerModel);
     });
+    const bool fromNeedles = chosen("shadow_origin", [&] {
+        const std::vector<std::string> known = shadowOriginNames();
+        if (std::find(known.begin(), known.end(), model.shadowOrigin) == known.end()) {
+            throw InputError("unknown shadow origin '" + model.shadowOrigin +
+                             "' (known: needles, axis)");
+        }
+        return model.shadowOrigin == "needles";
+    });
     const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
     TracedScene out;
     out.scene = &scene;
     out.layers = &layers;
+    out.shadowsFromNeedles = fromNeedles;
     out.lights = unifiedLights(scene);
     out.trees.resize(scene.trees.size());
     tbb::parallel_for(std::size_t(0), scene.trees.size(), [&](std::size_t i) {

@@ -51,13 +51,13 @@ vdbtrace::RenderOptions withProgress(const std::string& what)
 // it): --paper first, then each law named.
 struct ModelOverrides {
     bool paper = false;
-    std::string boughLaw, layerModel, extinctionLaw;
+    std::string boughLaw, layerModel, extinctionLaw, shadowOrigin;
 
     void add(CLI::App& cmd)
     {
         cmd.add_flag("--paper", paper,
                      "Every approximation as the paper prints it (render.preset \"paper\"): "
-                     "bough law linear, layer model paper, extinction law layer");
+                     "bough law linear, layer model paper, extinction law layer, shadow origin axis");
         cmd.add_option("--bough-law", boughLaw, "multiscale level 3's law (render.bough_law)")
             ->check(CLI::IsMember(vdbtrace::boughLawNames()));
         cmd.add_option("--layer-model", layerModel,
@@ -67,6 +67,10 @@ struct ModelOverrides {
                        "reference: the law of the bake, without --grids, whose files name "
                        "theirs (render.extinction_law)")
             ->check(CLI::IsMember(bake::extinctionLawNames()));
+        cmd.add_option("--shadow-origin", shadowOrigin,
+                       "multiscale: where a bough hit's shadow cone stands for "
+                       "(render.shadow_origin)")
+            ->check(CLI::IsMember(vdbtrace::shadowOriginNames()));
     }
     void apply(scenes::ModelChoices& model) const
     {
@@ -74,6 +78,7 @@ struct ModelOverrides {
         if (!boughLaw.empty()) model.boughLaw = boughLaw;
         if (!layerModel.empty()) model.layerModel = layerModel;
         if (!extinctionLaw.empty()) model.extinctionLaw = extinctionLaw;
+        if (!shadowOrigin.empty()) model.shadowOrigin = shadowOrigin;
     }
 };
 

@@ -84,15 +84,18 @@ struct ModelChoices {
     std::string boughLaw = "exact";       ///< level 3's law: "exact" or "linear" (sec. 6.6)
     std::string layerModel = "fibre";     ///< a layer's opacity: "fibre" or "paper" (const. A)
     std::string extinctionLaw = "fibre";  ///< the reference's field: "fibre" or "layer"
+    /// Where a bough hit's shadow cone stands for: "needles" (where the needles it shows lie)
+    /// or "axis" (one line from the chord's middle, section 7's shadow ray per bough).
+    std::string shadowOrigin = "needles";
     /// Every choice as the paper prints it (preset "paper"): today's published behaviour.
-    static ModelChoices paper() { return {"linear", "paper", "layer"}; }
+    static ModelChoices paper() { return {"linear", "paper", "layer", "axis"}; }
     /// The choices that agree with the explicit needles (preset "faithful", the default).
     static ModelChoices faithful() { return {}; }
 };
 
 struct RenderSettings {
     Vec3 background{0.55, 0.7, 0.9};
-    ModelChoices model;  ///< preset, then bough_law, layer_model, extinction_law
+    ModelChoices model;  ///< preset, then bough_law, layer_model, extinction_law, shadow_origin
     /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
     /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):
     /// q < needleLevelMax: level 1, needles resolved; q < coneLevelMax: level 2, each cone a

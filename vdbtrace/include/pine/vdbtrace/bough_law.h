@@ -36,6 +36,11 @@ struct BoughLightTransfer {
     /// bough's self-shadowing (section 6.6's I_FV / I^cyl and I_RV / I^cyl), across the
     /// view's strip.
     FrontRearProfile transfer;
+    /// With BoughShading::shadesNeedles: what each half reflects per unit irradiance, each
+    /// needle by eqs. 1-2 at its own direction (diffuse per unit albedo / pi, specular per
+    /// unit specular weight), with self-shadowing when asked: in place of the transfer times
+    /// the face's mean I^cyl, which holds only where the light reaches every needle alike.
+    FrontRearProfile diffuse, specular;
     /// The whole bough's opacity seen from the light, across the light's strip: what its
     /// shadow takes from light crossing it.
     StripProfile opacityFromLight;
@@ -45,10 +50,12 @@ struct BoughLightTransfer {
 struct BoughLawNeeds {
     bool transfer = true;        ///< self-shadowing: each light's transfer
     bool shadowOpacity = true;   ///< shadows: each light's opacity
+    bool diffuse = true;         ///< the diffuse reflectance, for a law that shades needles
+    bool specular = true;        ///< the specular one
     /// What a render of the effects `plan` reads.
     static BoughLawNeeds from(const EffectsPlan& plan)
     {
-        return {plan.selfShadowing, plan.shadowRays};
+        return {plan.selfShadowing, plan.shadowRays, plan.diffuse, plan.specular};
     }
 };
 
@@ -59,6 +66,8 @@ struct BoughShading {
     /// The strip the profiles are drawn on runs from the base to the cones' end (where the last
     /// cone's needles end), not to the tip: level 3 and shadows then draw it so.
     bool stripToConesEnd = false;
+    /// Each light's `diffuse` and `specular` profiles are set: level 3 reflects them.
+    bool shadesNeedles = false;
     std::vector<BoughLightTransfer> lights;  ///< one per light, in the scene's order
 };
 

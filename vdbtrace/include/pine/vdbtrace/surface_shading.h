@@ -16,14 +16,27 @@ namespace pine::vdbtrace {
 /// Marks a point that belongs to no primitive of the BVH (the ground, a voxel centre).
 inline constexpr std::size_t kNoPrimitive = std::size_t(-1);
 
+/// Where the needles lie that one shadow stands for (a bough's needles on a camera ray): points
+/// offset from the shadow's origin along `across` (unit, perpendicular to the light), each
+/// with the weight of the light it reflects to the pixel. The shadow is their weighted mean
+/// transmittance, each occluder read where each point's own shadow line passes it: what the
+/// explicit needles' shadow rays, one from each needle, average to.
+struct ShadowSamples {
+    struct Point {
+        double offset_cm, weight;
+    };
+    Vec3 across{0.0};
+    std::vector<Point> points;
+};
+
 /// How light reaches a point through a method's model of the scene: its shadows.
 class LightTransport {
 public:
     virtual ~LightTransport() = default;
     /// Transmittance from x to light `light` through everything but primitive `self`, for a
-    /// footprint `footprint_cm` wide at x.
+    /// footprint `footprint_cm` wide at x; with `samples`, their weighted mean (ShadowSamples).
     virtual double transmittance(const Vec3& x, std::size_t light, double footprint_cm,
-                                 std::size_t self) = 0;
+                                 std::size_t self, const ShadowSamples* samples) = 0;
 };
 
 /// Light arriving at a point from one light.
@@ -34,10 +47,11 @@ struct Incident {
 
 /// The shadow cone from x to light `light` (Light::shadowCone) through the branches (strip
 /// coverage of the cone's footprint) and, with `throughBoughs`, the boughs (that coverage times
-/// the bough law's opacity seen from the light), all but primitive `self`. Stops multiplying
-/// below 1e-4.
+/// the bough law's opacity seen from the light), all but primitive `self`; with `samples`
+/// their weighted mean, the cone widened to hold them all. Stops multiplying below 1e-4.
 double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::size_t light,
-                               double footprint_cm, std::size_t self, bool throughBoughs);
+                               double footprint_cm, std::size_t self, bool throughBoughs,
+                               const ShadowSamples* samples = nullptr);
 
 /// Per-thread shading of surfaces: branches as Lambertian cylinders (eq. 1 is the diffuse
 /// cylinder's reflectance, so bark is one), the ground as a Lambertian surface, both lit
@@ -53,6 +67,13 @@ public:
     /// Irradiance at x from each light, through the transport when the plan has shadow rays
     /// (each counted). Valid until the next call.
     const std::vector<Incident>& lightAt(const Vec3& x, double footprint_cm, std::size_t self);
+    /// Light `light` at x before any shadow.
+    Incident unshadowed(std::size_t light, const Vec3& x) const;
+    /// The transmittance from x to light `light` through the transport for a footprint
+    /// `footprint_cm` wide at x (counted as a shadow ray), the mean over `samples` if given;
+    /// 1 when the plan has no shadow rays.
+    double shadow(std::size_t light, const Vec3& x, double footprint_cm, std::size_t self,
+                  const ShadowSamples* samples = nullptr);
 
     /// Branch `index` (a primitive of the BVH) as the cone ray meets it before tMax: false
     /// when its strip covers none of the footprint.

@@ -45,6 +45,7 @@ struct TracedBranch {
 struct BoughLighting {
     analytic::FaceReflectance front, rear;  ///< I^cyl of each face (diffuse, specular)
     FrontRearProfile transfer;              ///< the bough law's, with self-shadowing
+    FrontRearProfile diffuse, specular;     ///< the law's, where it shades needles
     StripProfile opacityFromLight;          ///< the bough law's: the whole bough from the light
 };
 
@@ -76,6 +77,7 @@ struct TracedBough {
     Vec3 across{0.0};
     FrontRearProfile alpha;  ///< the bough law's opacity of each half seen from the camera
     RearComposite rearComposite = RearComposite::Own;  ///< how the law's rear half composites
+    bool shadesNeedles = false;  ///< level 3 reflects the law's diffuse and specular profiles
     unsigned seed = 0;          ///< drives the needles' azimuths at level 1
     std::vector<BoughLighting> lighting;  ///< one per light
 };
@@ -100,6 +102,9 @@ struct TracedScene {
     std::vector<TracedBough> boughs;     ///< primitive index branches.size() + j
     Bvh bvh;
     const LayerModel* layers = nullptr;  ///< how a layer stops a line (layer_model.h)
+    /// render.shadow_origin "needles": a bough hit's shadow cone stands for where the needles
+    /// it shows lie (ShadowSamples); "axis": one line from the chord's middle.
+    bool shadowsFromNeedles = true;
 
     bool isBranch(std::size_t primitive) const { return primitive < branches.size(); }
     const TracedBough& bough(std::size_t primitive) const
@@ -107,6 +112,9 @@ struct TracedScene {
         return boughs[primitive - branches.size()];
     }
 };
+
+/// The values of render.shadow_origin, the faithful one first.
+std::vector<std::string> shadowOriginNames();
 
 /// Grows every tree and prepares the scene for its camera under the scene's bough law and
 /// layer model (scene.render.model), in parallel. Keeps a pointer to `scene`, which must
