@@ -31,8 +31,13 @@ namespace {
 // through the plane of the axis and the chord maps cones onto cones), so opacities are
 // computed on half the cells; transfers are not even (the light is on one side).
 constexpr int kCells = 12;
-constexpr int kChords = 10;
-constexpr int kEndChords = 3;  ///< of kChords at each end of a bough with an interior
+// A chord's layers, each lit through the bough: the shading's chords cost a walk towards each
+// light per layer and are fewer; the opacity from a light, whose deep shadows show its every
+// cell, takes more.
+struct Chords {
+    int count, atEachEnd;  ///< per cell; of them at each end of a bough with an interior
+};
+constexpr Chords kShadingChords{6, 2}, kOpacityChords{10, 3};
 // Below this transmittance a chord stops: nothing behind shows.
 constexpr double kOpaque = 1e-4;
 
@@ -51,9 +56,10 @@ double cellCentre(int k) { return -1.0 + (k + 0.5) * 2.0 / kCells; }
 // last one fell, an end or an arbitrary phase (a cell 10% off the needles). A bough too short
 // for an interior spreads all its chords evenly. Each cell's chords are shifted by a
 // different fraction, so that the cells do not share where the cones fall.
-bool chord(const TracedBough& b, const Vec3& d, const Vec3& across, int k, int p, Vec3& o,
-           double& tIn, double& tOut, double& weight)
+bool chord(const TracedBough& b, const Vec3& d, const Vec3& across, int k, int p,
+           const Chords& chords, Vec3& o, double& tIn, double& tOut, double& weight)
 {
+    const int kChords = chords.count, kEndChords = chords.atEachEnd;
     const double xi = cellCentre(k) * b.radius_cm;
     const double c = glm::dot(d, b.axis), s = std::sqrt(std::max(0.0, 1.0 - c * c));
     const double cotangent = s > 0.05 ? std::abs(c) / s : 20.0;
@@ -74,7 +80,7 @@ bool chord(const TracedBough& b, const Vec3& d, const Vec3& across, int k, int p
         length = (to - from) / kEndChords;
         at = from + (p % kEndChords + shift) * length;
     } else {
-        constexpr int interior = kChords - 2 * kEndChords;
+        const int interior = kChords - 2 * kEndChords;
         length = (interiorTo - interiorFrom) / interior;
         const double middle = 0.5 * (interiorFrom + interiorTo);
         at = middle + dh * ((p - 2 * kEndChords + shift) / interior - 0.5);
@@ -109,10 +115,10 @@ public:
         for (int k = 0; k < kCells; ++k) {
             // Opacities are even in the offset: with no light to shade, half the cells do.
             if (lights == 0 && k >= kCells / 2) continue;
-            for (int p = 0; p < kChords; ++p) {
+            for (int p = 0; p < kShadingChords.count; ++p) {
                 Vec3 o;
                 double tIn, tOut, weight;
-                if (!chord(b, d, b.across, k, p, o, tIn, tOut, weight)) continue;
+                if (!chord(b, d, b.across, k, p, kShadingChords, o, tIn, tOut, weight)) continue;
                 const double tMid = 0.5 * (tIn + tOut);
                 double T = 1.0;
                 layers.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
@@ -190,10 +196,10 @@ private:
                 cells[k] = cells[kCells - 1 - k];
                 continue;
             }
-            for (int p = 0; p < kChords; ++p) {
+            for (int p = 0; p < kOpacityChords.count; ++p) {
                 Vec3 o;
                 double tIn, tOut, weight;
-                if (!chord(b, d, across, k, p, o, tIn, tOut, weight)) continue;
+                if (!chord(b, d, across, k, p, kOpacityChords, o, tIn, tOut, weight)) continue;
                 double T = 1.0;
                 layers.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
                     T *= 1.0 - hit.opacity;
