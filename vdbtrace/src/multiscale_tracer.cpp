@@ -76,7 +76,10 @@ private:
     std::vector<std::size_t> mByDepth;                ///< their indices, front to back
     std::vector<double> mSelf;       ///< their self-shadowing, hit-major, one per light
     std::vector<Incident> mLight;    ///< each light at the bough being shaded
-    std::vector<ShadowSamples::Point> mDepths;  ///< (depth along the ray, weight): shadowOf
+    struct Depth {
+        double t, weight;  ///< along the ray (cm); of the light reflected to the pixel
+    };
+    std::vector<Depth> mDepths;  ///< where a bough's lit needles lie: shadowOf
     ShadowSamples mShadowSamples;
 };
 
@@ -88,8 +91,8 @@ double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std:
     const double stretch = glm::length(across);  // of depth into offset across the light
     mShadowSamples.across = stretch > 1e-9 ? across / stretch : Vec3(0.0);
     mShadowSamples.points.clear();
-    for (const ShadowSamples::Point& d : mDepths) {
-        mShadowSamples.points.push_back({(d.offset_cm - tRef) * stretch, d.weight});
+    for (const Depth& d : mDepths) {
+        mShadowSamples.points.push_back({(d.t - tRef) * stretch, d.weight});
     }
     return mSurfaces.shadow(light, ray.origin + tRef * ray.direction, ray.width(tRef), index,
                             &mShadowSamples);
