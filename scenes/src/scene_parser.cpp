@@ -149,6 +149,15 @@ RenderSettings readRender(const Json& value, const Where& where)
         where.key("cone_level_max").fail("must exceed needle_level_max (" +
                                          detail::formatNumber(s.needleLevelMax) + ")");
     }
+    // The two bands must not overlap: a bough is mixed from two levels at most. Thresholds
+    // closer than the default band allows narrow it.
+    const double widest = std::sqrt(s.coneLevelMax / s.needleLevelMax);
+    s.model.levelBlend = r.number("level_blend", Range::atLeast(1),
+                                  std::min(s.model.levelBlend, widest));
+    if (s.model.levelBlend > widest) {
+        where.key("level_blend").fail("must be at most sqrt(cone_level_max / needle_level_max) (" +
+                                      detail::formatNumber(widest) + ")");
+    }
     r.finish();
     return s;
 }

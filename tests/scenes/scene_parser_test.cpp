@@ -186,17 +186,24 @@ TEST(SceneParser, ModelsAreFaithfulUnlessThePresetOrAKeySaysOtherwise)
     EXPECT_EQ(faithful.layerModel, "fibre");
     EXPECT_EQ(faithful.extinctionLaw, "fibre");
     EXPECT_EQ(faithful.shadowOrigin, "needles");
+    EXPECT_EQ(faithful.levelBlend, 1.5);
     j["render"]["preset"] = "paper";
     const ModelChoices paper = parseScene(j.dump(), "m.json").render.model;
     EXPECT_EQ(paper.boughLaw, "linear");
     EXPECT_EQ(paper.layerModel, "paper");
     EXPECT_EQ(paper.extinctionLaw, "layer");
     EXPECT_EQ(paper.shadowOrigin, "axis");
+    EXPECT_EQ(paper.levelBlend, 1.0);
     // A key after the preset overrides it alone.
     j["render"]["layer_model"] = "fibre";
     const ModelChoices mixed = parseScene(j.dump(), "m.json").render.model;
     EXPECT_EQ(mixed.boughLaw, "linear");
     EXPECT_EQ(mixed.layerModel, "fibre");
+    j["render"]["level_blend"] = 2.5;  // the bands about 0.25 and 1 would overlap past 2
+    expectError(j, "render.level_blend", "must be at most sqrt(cone_level_max / needle_level_max) (2)");
+    j["render"]["level_blend"] = 0.5;
+    expectError(j, "render.level_blend", "must be >= 1");
+    j["render"].erase("level_blend");
     j["render"]["preset"] = "printed";
     expectError(j, "render.preset", "must be \"faithful\" or \"paper\"");
 }

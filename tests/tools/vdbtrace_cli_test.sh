@@ -41,6 +41,8 @@ grep -q '"bough_law": "linear"' "$work/p.json" || fail "--paper did not choose t
 grep -q '"layer_model": "paper"' "$work/p.json" || fail "--paper did not choose the paper's layers"
 grep -q '"shadow_origin": "axis"' "$work/p.json" || fail "--paper did not choose shadows from the axis"
 grep -q '"shadow_origin": "needles"' "$work/b.json" || fail "default shadow origin not recorded as needles"
+grep -q '"level_blend": 1.5' "$work/b.json" || fail "default level blend not recorded as 1.5"
+grep -q '"level_blend": 1.0' "$work/p.json" || fail "--paper did not turn the level blend off"
 "$vdbtrace" render "$src/scenes/bough.json" --paper --layer-model fibre --out "$work/p.exr" --stats "$work/p.json" 2>/dev/null \
     || fail "render --paper --layer-model fibre failed"
 grep -q '"layer_model": "fibre"' "$work/p.json" || fail "--layer-model did not override --paper"

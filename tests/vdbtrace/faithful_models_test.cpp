@@ -170,19 +170,11 @@ TEST(FaithfulModels, ARecedingBoughNeitherPopsNorFades)
     // a few pixels tall) in steps of 1.25x: the boughs' covered width (the area they cover,
     // coverage summed over the pixels times a pixel's area at the boughs, over the frame's
     // width, which rounding to whole pixels changes a little) and their luminance likewise.
-    // Coverage changes by less than 2% across both level thresholds (q = 0.25 and 1). The
-    // luminance by up to 3.4% at q = 1 (measured; bounded at 3.5%): level 3 shades each half
-    // with its face's mean reflectance (section 6.6's I^cyl), where levels 1-2 shade each
-    // needle; the exact law keeps that closed form. Level 2 is point-sampled, one ray
-    // per pixel, and as the footprint nears dh the pixels sample the cones at about their own
-    // spacing, along the strip and across it: the total moves with the pixel grid's phase
-    // (measured +-2% around its mean for q from 0.6 to 1 in steps of 3%; two lines per
-    // pixel across the strip did not reduce it), bounded at 4% between neighbours, and it is
-    // most of the jumps at the thresholds.
-    // Levels 1 and 3 are anti-aliased across the strip and move by less than 1%. The curve
-    // is printed.
+    // Neither moves by more than 2% between neighbouring distances (measured: 0.9% and 1.3%).
+    // Without the blend of levels (render.level_blend 1) the luminance stepped by 2.2% at
+    // q = 0.25; without level 2 taking the law's coverage at the strip's edge the pixel
+    // grid's phase moved level 2 by 3% near q = 1. The curve is printed.
     double previousCoverage = 0.0, previousLuminance = 0.0;
-    int previousLevel = 0;
     for (double q = 0.05; q < 20.01; q *= 1.25) {
         const RecedingBoughs s(q);
         const RenderResult r = renderMultiscale(s.traced);
@@ -202,16 +194,11 @@ TEST(FaithfulModels, ARecedingBoughNeitherPopsNorFades)
         std::printf("q %7.3f  %4dx%-4d  level %d  covered width %.4f cm  luminance %.6f\n", q,
                     r.image.width, r.image.height, level, coverage, lum);
         if (previousCoverage > 0.0) {
-            const bool within2 = level == 2 && previousLevel == 2;
-            const bool across = level != previousLevel;
-            EXPECT_NEAR(coverage / previousCoverage, 1.0, within2 ? 0.04 : across ? 0.02 : 0.01)
-                << "q " << q;
-            EXPECT_NEAR(lum / previousLuminance, 1.0, within2 ? 0.04 : across ? 0.035 : 0.01)
-                << "q " << q;
+            EXPECT_NEAR(coverage / previousCoverage, 1.0, 0.02) << "q " << q;
+            EXPECT_NEAR(lum / previousLuminance, 1.0, 0.02) << "q " << q;
         }
         previousCoverage = coverage;
         previousLuminance = lum;
-        previousLevel = level;
     }
 }
 

@@ -17,7 +17,8 @@ nlohmann::json describeMultiscale(const scenes::Scene& scene, const MethodSettin
 {
     return {{"bough_law", scene.render.model.boughLaw},
             {"layer_model", scene.render.model.layerModel},
-            {"shadow_origin", scene.render.model.shadowOrigin}};
+            {"shadow_origin", scene.render.model.shadowOrigin},
+            {"level_blend", scene.render.model.levelBlend}};
 }
 
 RenderResult reference(const TracedScene& scene, const MethodSettings& s,

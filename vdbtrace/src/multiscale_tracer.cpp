@@ -41,6 +41,8 @@ private:
         return shadowConeTransmittance(mScene, x, light, footprint_cm, self, true, samples);
     }
     void addBough(const ConeRay& ray, std::size_t index);
+    // The bough's fragments at `level`.
+    void addBoughAt(const ConeRay& ray, std::size_t index, Level level);
     void addCrossings(const ConeRay& ray, std::size_t index, const TracedBough& b, double tIn,
                       double tOut, double coverage, Level level);
     // A needle of cone `cone` the ray meets at depth t, of which the pixel sees alpha.
@@ -204,6 +206,28 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
             }
             mNeedleHits.push_back({hit.cone, cosPhi * b.axis + sinPhi * radial, hit.t, alpha});
         }
+        // At the strip's edge one line stands for a footprint across which the bough thins:
+        // its layers' coverage times the line's opacity is not the footprint's mean, and
+        // as the footprint nears the cone spacing it moves with where the pixels fall (up to
+        // 3% between neighbouring distances). Where the law is a profile read over the
+        // footprint (the exact law's shares), the layers keep their order and shading and
+        // take the law's coverage.
+        Passage p;
+        if (coverage < 1.0 && covered > 0.0 && b.rearComposite == RearComposite::Share &&
+            closestPassage(ray, b.base_cm, b.conesEnd_cm, p)) {
+            const double w = ray.width(p.t);
+            const double xi = std::copysign(
+                p.gap, glm::dot(ray.origin + p.t * ray.direction - b.base_cm, b.across));
+            const double target = b.alpha.front.overFootprint(xi, b.radius_cm, w) +
+                                  b.alpha.rear.overFootprint(xi, b.radius_cm, w);
+            const double k = std::min(target, 0.999) / covered;
+            double before = 0.0;
+            for (NeedleHit& h : mNeedleHits) {
+                const double share = h.alpha * (1.0 - before) * k;
+                h.alpha = before < 1.0 ? share / (1.0 - before) : 0.0;
+                before += share;
+            }
+        }
         shadeNeedles(ray, index, b, tIn, tOut, 2);
         return;
     }
@@ -247,6 +271,41 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
 void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
 {
     const TracedBough& b = mScene.bough(index);
+    Passage p;
+    if (!closestPassage(ray, b.base_cm, b.conesEnd_cm, p)) return;
+    const double w = ray.width(p.t);
+    if (mForceLevel) return addBoughAt(ray, index, Level(mForceLevel));
+    const LevelBlend blend = blendLevels(w, b.geometry.coneSpacing_cm, mSettings);
+    if (!(blend.upperWeight > 0.0)) return addBoughAt(ray, index, blend.lower);
+    if (!(blend.upperWeight < 1.0)) return addBoughAt(ray, index, blend.upper);
+    // Within a band about a threshold: each level's fragments composited alone, the two
+    // results mixed, as one fragment at the bough's front.
+    const std::size_t from = mFragments.size();
+    addBoughAt(ray, index, blend.lower);
+    const std::size_t middle = mFragments.size();
+    addBoughAt(ray, index, blend.upper);
+    const auto composite = [&](std::size_t a, std::size_t z) {
+        std::sort(mFragments.begin() + a, mFragments.begin() + z,
+                  [](const Fragment& x, const Fragment& y) { return x.t < y.t; });
+        FrontToBack local;
+        for (std::size_t i = a; i < z; ++i) local.add(mFragments[i]);
+        return local.value();
+    };
+    const SampleValue lo = composite(from, middle), hi = composite(middle, mFragments.size());
+    const double u = blend.upperWeight;
+    double t = std::numeric_limits<double>::infinity();
+    for (std::size_t i = from; i < mFragments.size(); ++i) t = std::min(t, mFragments[i].t);
+    mFragments.resize(from);
+    if (!(lo.alpha + hi.alpha > 0.0)) return;
+    mFragments.push_back(Fragment{t, (1.0 - u) * lo.alpha + u * hi.alpha,
+                                  (1.0 - u) * lo.diffuse + u * hi.diffuse,
+                                  (1.0 - u) * lo.specular + u * hi.specular,
+                                  int(u < 0.5 ? blend.lower : blend.upper), true});
+}
+
+void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Level level)
+{
+    const TracedBough& b = mScene.bough(index);
     // Where the cone passes the needles: they reach from the base to the cones' end.
     Passage p;
     if (!closestPassage(ray, b.base_cm, b.conesEnd_cm, p)) return;
@@ -256,8 +315,6 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     // The chord's signed offset from the axis, across the strip (bough_law.h).
     const double xi =
         std::copysign(p.gap, glm::dot(ray.origin + p.t * ray.direction - b.base_cm, b.across));
-    const Level level = mForceLevel ? Level(mForceLevel)
-                                    : chooseLevel(w, b.geometry.coneSpacing_cm, mSettings);
     double tIn, tOut;
     if (level != Level::Bough) {
         // Cones and needles are found along the cone's axis; where the axis misses them the
@@ -383,6 +440,26 @@ private:
 };
 
 }  // namespace
+
+LevelBlend blendLevels(double footprint_cm, double coneSpacing_cm,
+                       const scenes::RenderSettings& s)
+{
+    const double q = footprint_cm / coneSpacing_cm;
+    const Level level = chooseLevel(footprint_cm, coneSpacing_cm, s);
+    LevelBlend out{level, level, 0.0};
+    // Never wider than keeps the two bands apart (a command line's value is not checked
+    // against the scene's thresholds).
+    const double band = std::min(s.model.levelBlend, std::sqrt(s.coneLevelMax / s.needleLevelMax));
+    if (!(band > 1.0)) return out;
+    for (const auto& [threshold, lower] :
+         {std::pair{s.needleLevelMax, Level::Needle}, std::pair{s.coneLevelMax, Level::Cone}}) {
+        const double u = std::log(q / threshold) / std::log(band);  // -1 to 1 across the band
+        if (std::abs(u) >= 1.0) continue;
+        const double x = 0.5 * (u + 1.0);
+        out = {lower, Level(int(lower) + 1), x * x * (3.0 - 2.0 * x)};
+    }
+    return out;
+}
 
 Level chooseLevel(double footprint_cm, double coneSpacing_cm, const scenes::RenderSettings& s)
 {

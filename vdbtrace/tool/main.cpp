@@ -52,12 +52,14 @@ vdbtrace::RenderOptions withProgress(const std::string& what)
 struct ModelOverrides {
     bool paper = false;
     std::string boughLaw, layerModel, extinctionLaw, shadowOrigin;
+    double levelBlend = 0.0;  ///< 0: the scene's
 
     void add(CLI::App& cmd)
     {
         cmd.add_flag("--paper", paper,
                      "Every approximation as the paper prints it (render.preset \"paper\"): "
-                     "bough law linear, layer model paper, extinction law layer, shadow origin axis");
+                     "bough law linear, layer model paper, extinction law layer, shadow origin axis, "
+                     "no level blend");
         cmd.add_option("--bough-law", boughLaw, "multiscale level 3's law (render.bough_law)")
             ->check(CLI::IsMember(vdbtrace::boughLawNames()));
         cmd.add_option("--layer-model", layerModel,
@@ -71,6 +73,10 @@ struct ModelOverrides {
                        "multiscale: where a bough hit's shadow cone stands for "
                        "(render.shadow_origin)")
             ->check(CLI::IsMember(vdbtrace::shadowOriginNames()));
+        cmd.add_option("--level-blend", levelBlend,
+                       "multiscale: the band about each level threshold over which two levels "
+                       "are mixed, as a ratio of q (1: none; render.level_blend)")
+            ->check(CLI::Range(1.0, 2.0));
     }
     void apply(scenes::ModelChoices& model) const
     {
@@ -79,6 +85,7 @@ struct ModelOverrides {
         if (!layerModel.empty()) model.layerModel = layerModel;
         if (!extinctionLaw.empty()) model.extinctionLaw = extinctionLaw;
         if (!shadowOrigin.empty()) model.shadowOrigin = shadowOrigin;
+        if (levelBlend > 0.0) model.levelBlend = levelBlend;
     }
 };
 

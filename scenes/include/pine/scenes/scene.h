@@ -87,15 +87,19 @@ struct ModelChoices {
     /// Where a bough hit's shadow cone stands for: "needles" (where the needles it shows lie)
     /// or "axis" (one line from the chord's middle, section 7's shadow ray per bough).
     std::string shadowOrigin = "needles";
+    /// Within q in [t / levelBlend, t levelBlend] about each level threshold t a bough is
+    /// shaded at both levels and the two mixed (smoothstep in log q); 1: the paper's switch.
+    double levelBlend = 1.5;
     /// Every choice as the paper prints it (preset "paper"): today's published behaviour.
-    static ModelChoices paper() { return {"linear", "paper", "layer", "axis"}; }
+    static ModelChoices paper() { return {"linear", "paper", "layer", "axis", 1.0}; }
     /// The choices that agree with the explicit needles (preset "faithful", the default).
     static ModelChoices faithful() { return {}; }
 };
 
 struct RenderSettings {
     Vec3 background{0.55, 0.7, 0.9};
-    ModelChoices model;  ///< preset, then bough_law, layer_model, extinction_law, shadow_origin
+    /// preset, then bough_law, layer_model, extinction_law, shadow_origin, level_blend
+    ModelChoices model;
     /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
     /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):
     /// q < needleLevelMax: level 1, needles resolved; q < coneLevelMax: level 2, each cone a

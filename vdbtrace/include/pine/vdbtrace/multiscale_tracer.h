@@ -12,6 +12,15 @@ namespace pine::vdbtrace {
 enum class Level { Needle = 1, Cone = 2, Bough = 3 };
 Level chooseLevel(double footprint_cm, double coneSpacing_cm, const scenes::RenderSettings& s);
 
+/// Two neighbouring levels and the weight of the upper one: within a band about a threshold
+/// the bough is shaded at both and the results mixed, so that nothing steps where q crosses it.
+struct LevelBlend {
+    Level lower, upper;
+    double upperWeight;  ///< 0: lower alone, 1: upper alone
+};
+LevelBlend blendLevels(double footprint_cm, double coneSpacing_cm,
+                       const scenes::RenderSettings& s);
+
 struct MultiscaleOptions {
     /// Forces every bough hit to this level (0: choose by footprint) - for comparisons.
     int forceLevel = 0;
