@@ -221,11 +221,12 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
             const double target = b.alpha.front.overFootprint(xi, b.radius_cm, w) +
                                   b.alpha.rear.overFootprint(xi, b.radius_cm, w);
             const double k = std::min(target, 0.999) / covered;
-            double before = 0.0;
+            double was = 0.0, before = 0.0;  // covered in front, as composited and as scaled
             for (NeedleHit& h : mNeedleHits) {
-                const double share = h.alpha * (1.0 - before) * k;
-                h.alpha = before < 1.0 ? share / (1.0 - before) : 0.0;
-                before += share;
+                const double share = h.alpha * (1.0 - was);
+                was += share;
+                h.alpha = before < 1.0 ? k * share / (1.0 - before) : 0.0;
+                before += k * share;
             }
         }
         shadeNeedles(ray, index, b, tIn, tOut, 2);
