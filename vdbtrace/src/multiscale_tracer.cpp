@@ -41,10 +41,13 @@ private:
         return shadowConeTransmittance(mScene, x, light, footprint_cm, self, true, samples);
     }
     void addBough(const ConeRay& ray, std::size_t index);
-    // The bough's fragments at `level`.
-    void addBoughAt(const ConeRay& ray, std::size_t index, Level level);
+    // The bough's fragments at `level`, the ray passing its needles at `passage` (base to
+    // the cones' end).
+    void addBoughAt(const ConeRay& ray, std::size_t index, Level level, const Passage& passage);
+    // Levels 1-2 over [tIn, tOut]; the strip covers `coverage` of the footprint, `w` wide, at
+    // signed offset xi from the axis.
     void addCrossings(const ConeRay& ray, std::size_t index, const TracedBough& b, double tIn,
-                      double tOut, double coverage, Level level);
+                      double tOut, double coverage, double xi, double w, Level level);
     // A needle of cone `cone` the ray meets at depth t, of which the pixel sees alpha.
     struct NeedleHit {
         long cone;
@@ -168,7 +171,7 @@ void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
 
 void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
                                        const TracedBough& b, double tIn, double tOut,
-                                       double coverage, Level level)
+                                       double coverage, double xi, double w, Level level)
 {
     const double phi = b.geometry.cone.aperture_rad;
     const double cotPhi = 1.0 / std::tan(phi), sinPhi = std::sin(phi), cosPhi = std::cos(phi);
@@ -212,12 +215,7 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
         // 3% between neighbouring distances). Where the law is a profile read over the
         // footprint (the exact law's shares), the layers keep their order and shading and
         // take the law's coverage.
-        Passage p;
-        if (coverage < 1.0 && covered > 0.0 && b.rearComposite == RearComposite::Share &&
-            closestPassage(ray, b.base_cm, b.conesEnd_cm, p)) {
-            const double w = ray.width(p.t);
-            const double xi = std::copysign(
-                p.gap, glm::dot(ray.origin + p.t * ray.direction - b.base_cm, b.across));
+        if (coverage < 1.0 && covered > 0.0 && b.rearComposite == RearComposite::Share) {
             const double target = b.alpha.front.overFootprint(xi, b.radius_cm, w) +
                                   b.alpha.rear.overFootprint(xi, b.radius_cm, w);
             const double k = std::min(target, 0.999) / covered;
@@ -272,19 +270,20 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
 void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
 {
     const TracedBough& b = mScene.bough(index);
+    // Where the cone passes the needles: they reach from the base to the cones' end.
     Passage p;
     if (!closestPassage(ray, b.base_cm, b.conesEnd_cm, p)) return;
     const double w = ray.width(p.t);
-    if (mForceLevel) return addBoughAt(ray, index, Level(mForceLevel));
+    if (mForceLevel) return addBoughAt(ray, index, Level(mForceLevel), p);
     const LevelBlend blend = blendLevels(w, b.geometry.coneSpacing_cm, mSettings);
-    if (!(blend.upperWeight > 0.0)) return addBoughAt(ray, index, blend.lower);
-    if (!(blend.upperWeight < 1.0)) return addBoughAt(ray, index, blend.upper);
+    if (!(blend.upperWeight > 0.0)) return addBoughAt(ray, index, blend.lower, p);
+    if (!(blend.upperWeight < 1.0)) return addBoughAt(ray, index, blend.upper, p);
     // Within a band about a threshold: each level's fragments composited alone, the two
     // results mixed, as one fragment at the bough's front.
     const std::size_t from = mFragments.size();
-    addBoughAt(ray, index, blend.lower);
+    addBoughAt(ray, index, blend.lower, p);
     const std::size_t middle = mFragments.size();
-    addBoughAt(ray, index, blend.upper);
+    addBoughAt(ray, index, blend.upper, p);
     const auto composite = [&](std::size_t a, std::size_t z) {
         std::sort(mFragments.begin() + a, mFragments.begin() + z,
                   [](const Fragment& x, const Fragment& y) { return x.t < y.t; });
@@ -304,12 +303,11 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
                                   int(u < 0.5 ? blend.lower : blend.upper), true});
 }
 
-void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Level level)
+void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Level level,
+                                     const Passage& passage)
 {
     const TracedBough& b = mScene.bough(index);
-    // Where the cone passes the needles: they reach from the base to the cones' end.
-    Passage p;
-    if (!closestPassage(ray, b.base_cm, b.conesEnd_cm, p)) return;
+    Passage p = passage;
     const double w = ray.width(p.t);
     const double c = stripCoverage(p.gap, b.radius_cm, w);
     if (c <= 0.0) return;
@@ -321,7 +319,7 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         // Cones and needles are found along the cone's axis; where the axis misses them the
         // footprint only grazes the bough: shade the volume.
         if (layeredInterval(b, ray.origin, ray.direction, tIn, tOut)) {
-            addCrossings(ray, index, b, tIn, tOut, c, level);
+            addCrossings(ray, index, b, tIn, tOut, c, xi, w, level);
             return;
         }
     }
