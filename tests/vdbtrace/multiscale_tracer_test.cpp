@@ -204,41 +204,36 @@ TEST(BoughLaw, OneCallOfTheLawGivesEveryBoughLevelQuantity)
     EXPECT_NEAR(centre[1], expected, 1e-6 * expected);
 }
 
-TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
+// Calls f, which must throw an InputError whose message holds `text`.
+template <class F>
+void expectInputError(F&& f, const std::string& text)
 {
     try {
-        boughLaw("quadratic");
+        f();
         ADD_FAILURE() << "no InputError";
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("exact, linear"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
     }
+}
+
+TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
+{
+    expectInputError([] { boughLaw("quadratic"); }, "exact, linear");
     // The first registered is the scene's default.
     EXPECT_EQ(boughLawNames().front(), scenes::ModelChoices{}.boughLaw);
     EXPECT_EQ(layerModelNames().front(), scenes::ModelChoices{}.layerModel);
     // A scene that names an unknown one is refused before any work, with its key.
     scenes::Scene scene = scenes::parseScene(firScene(R"("diffuse")", 16, 12), "fir.json");
     scene.render.model.layerModel = "foam";
-    try {
-        buildTracedScene(scene);
-        ADD_FAILURE() << "no InputError";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("fir.json: render.layer_model: unknown layer model "
-                                             "'foam' (known: fibre, paper)"),
-                  std::string::npos)
-            << e.what();
-    }
+    expectInputError([&] { buildTracedScene(scene); },
+                     "fir.json: render.layer_model: unknown layer model 'foam' (known: fibre, "
+                     "paper)");
     EXPECT_EQ(shadowOriginNames().front(), scenes::ModelChoices{}.shadowOrigin);
     scene.render.model = {};
     scene.render.model.shadowOrigin = "sun";
-    try {
-        buildTracedScene(scene);
-        ADD_FAILURE() << "no InputError";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("fir.json: render.shadow_origin: unknown shadow "
-                                             "origin 'sun' (known: needles, axis)"),
-                  std::string::npos)
-            << e.what();
-    }
+    expectInputError([&] { buildTracedScene(scene); },
+                     "fir.json: render.shadow_origin: unknown shadow origin 'sun' (known: "
+                     "needles, axis)");
 }
 
 TEST(MultiscaleTracer, ConeLevelCrossesTheTrueCones)
