@@ -8,6 +8,7 @@ namespace pine::bake {
 
 std::unique_ptr<ExtinctionLaw> makeFibreExtinctionLaw();
 std::unique_ptr<ExtinctionLaw> makeLayerExtinctionLaw();
+std::unique_ptr<ExtinctionLaw> makePoissonExtinctionLaw();
 
 namespace {
 
@@ -15,8 +16,9 @@ const Registry<ExtinctionLaw>& registry()
 {
     static const Registry<ExtinctionLaw> laws = [] {
         Registry<ExtinctionLaw> r("extinction law");
-        r.add("fibre", makeFibreExtinctionLaw());  // the needles as thin fibres (faithful)
-        r.add("layer", makeLayerExtinctionLaw());  // section 6's layers (the paper's)
+        r.add("fibre", makeFibreExtinctionLaw());      // evenly spaced thin fibres (faithful)
+        r.add("layer", makeLayerExtinctionLaw());      // section 6's layers (the paper's)
+        r.add("poisson", makePoissonExtinctionLaw());  // fibres placed independently
         return r;
     }();
     return laws;

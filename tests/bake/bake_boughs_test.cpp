@@ -105,10 +105,10 @@ openvdb::CoordBBox searchBox(const BoughSpec& b, double h)
     return box;
 }
 
-TEST(BakeBoughs, FibreMassIsTheNeedlesMeanProjectedArea)
+TEST(BakeBoughs, PoissonMassIsTheNeedlesMeanProjectedArea)
 {
     // Cauchy: a thin needle of length l and radius r shows a mean projected area (pi / 4) 2 r l
-    // over all directions, so under the fibre law sum(mean extinction x h^3) is (pi / 4) 2 r
+    // over all directions, so under the Poisson law sum(mean extinction x h^3) is (pi / 4) 2 r
     // times the needles' total length, N l L / dh, less what the cap on their coverage
     // removes near the axis: there min(1, N r / (pi rho)) = 1 for rho < rho0 = N r / pi, which
     // takes pi rho0^2 L / (dh sin(phi)) (pi / 4) from the integral of the uncapped coverage.
@@ -120,7 +120,7 @@ TEST(BakeBoughs, FibreMassIsTheNeedlesMeanProjectedArea)
                          (2.0 * c.needleRadius_cm * c.needlesPerCone * c.needleLength_cm * L / dh -
                           kPi * rho0 * rho0 * L / (dh * sinPhi));
     const double h = c.needleLength_cm * sinPhi / 16;
-    const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 1, "fibre"});
+    const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 1, "poisson"});
     // The coverage's 1 / rho near the axis adds a little to the voxel error of the layer law.
     EXPECT_NEAR(voxelizedMass(g) / exact, 1.0, 0.01);
 }

@@ -3,6 +3,7 @@
 #include "pine/analytic/needle_shader.h"
 #include "pine/bake/extinction_law.h"
 #include "pine/vdbtrace/effects_plan.h"
+#include "pine/vdbtrace/layer_bands.h"
 #include "pine/vdbtrace/render_driver.h"
 #include "pine/vdbtrace/surface_shading.h"
 
@@ -73,18 +74,42 @@ struct FieldReader {
           coverage(g.needleCoverage->getConstAccessor())
     {
     }
-    /// sigma(d) at voxel ijk, per cm; 0 outside the boughs.
-    double extinction(const openvdb::Coord& ijk, const Vec3& d)
+    /// A line along d through voxel ijk, per cm: the law's sigma(d) and the layers crossed,
+    /// d . G (signed); both 0 outside the boughs.
+    struct Rates {
+        double sigma = 0.0, layers = 0.0;
+    };
+    Rates rates(const openvdb::Coord& ijk, const Vec3& d)
     {
         float A;
-        if (!opacity.probeValue(ijk, A) || !(A > 0.0f)) return 0.0;
+        if (!opacity.probeValue(ijk, A) || !(A > 0.0f)) return {};
         bake::LayerSample field;  // all of it: a law may read any field
         field.layerOpacity = A;
         field.gradient = toGlm(gradient.getValue(ijk));
         field.needle = toGlm(needle.getValue(ijk));
         field.needleCoverage = coverage.getValue(ijk);
-        return law.extinction(field, d);
+        return {law.extinction(field, d), glm::dot(d, field.gradient)};
     }
+};
+
+// One line's spans through the field, in order: the transmittance of each, exp(-sigma dt) for
+// an extinction law, the bands of evenly spaced needles for a banded one (layer_bands.h).
+class LineThroughField {
+public:
+    explicit LineThroughField(const bake::ExtinctionLaw& law) : mBanded(law.banded()) {}
+
+    double transmittance(const FieldReader::Rates& r, double ta, double tb)
+    {
+        if (!mBanded) return std::exp(-r.sigma * (tb - ta));
+        if (ta > mEnd) mBands.span(0.0, 0.0);  // out of the medium and in again: a new band
+        mEnd = tb;
+        return mBands.span(r.sigma * (tb - ta), r.layers * (tb - ta));
+    }
+
+private:
+    bool mBanded;
+    LayerBands mBands;
+    double mEnd = -std::numeric_limits<double>::infinity();
 };
 
 class ReferenceRayTracer;
@@ -141,11 +166,11 @@ public:
         double distance;
         mScene.lights[light].at(x, L, distance, irradiance);
         const double tMax = std::isfinite(distance) ? distance : 1e7;
-        double tau = 0.0;
+        double T = 1.0;
+        LineThroughField line(thread.field.law);
         march(thread, x, L, tMax, [&](const openvdb::Coord& ijk, double ta, double tb) {
-            tau += thread.field.extinction(ijk, L) * (tb - ta);
+            if (T > 0.0) T *= line.transmittance(thread.field.rates(ijk, L), ta, tb);
         });
-        double T = std::exp(-tau);
         if (mPlan.shadowRays) {
             T *= shadowConeTransmittance(mScene, x, light, footprint_cm, self, false);
         }
@@ -274,25 +299,27 @@ void ReferenceRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
               [](const Fragment& a, const Fragment& b) { return a.t < b.t; });
 
     const Vec3 V = -ray.direction;
-    const auto volume = [](double sigma, double dt, const Vec3& jd, const Vec3& js, double t) {
-        const double alpha = 1.0 - std::exp(-sigma * dt);
-        return Fragment{t, alpha, alpha * jd, alpha * js, 0, true};
-    };
+    LineThroughField line(mThread.field.law);
     std::size_t next = 0;
     mMethod.march(mThread, ray.origin, ray.direction, tEnd,
                   [&](const openvdb::Coord& ijk, double ta, double tb) {
         if (composite.opaque()) return;
         ++mStats.voxelSpans;
-        const double sigma = mThread.field.extinction(ijk, ray.direction);
+        const FieldReader::Rates rates = mThread.field.rates(ijk, ray.direction);
         Vec3 jd(0.0), js(0.0);
-        if (sigma > 0.0) emission(ijk, V, jd, js);
+        if (rates.sigma > 0.0) emission(ijk, V, jd, js);
+        // The volume over [t0, t1] as a fragment: its opacity, and J premultiplied by it.
+        const auto volume = [&](double t0, double t1) {
+            const double alpha = 1.0 - line.transmittance(rates, t0, t1);
+            composite.add(Fragment{t0, alpha, alpha * jd, alpha * js, 0, true});
+        };
         while (next < surfaces.size() && surfaces[next].t <= tb) {
             const double ts = std::max(ta, surfaces[next].t);
-            if (sigma > 0.0) composite.add(volume(sigma, ts - ta, jd, js, ta));
+            if (rates.sigma > 0.0) volume(ta, ts);
             composite.add(surfaces[next++]);
             ta = ts;
         }
-        if (sigma > 0.0) composite.add(volume(sigma, tb - ta, jd, js, ta));
+        if (rates.sigma > 0.0) volume(ta, tb);
     });
     while (next < surfaces.size() && !composite.opaque()) composite.add(surfaces[next++]);
 }

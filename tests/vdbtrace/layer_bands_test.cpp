@@ -1,0 +1,139 @@
+// The fibre extinction law's bands (layer_bands.h) against what they stand for: evenly spaced
+// needles stop a line at each layer it crosses with probability n, the needles' projected
+// width there, however the line is cut into voxel spans; a band ends where the line turns
+// back through the layers or leaves the medium.
+#include "pine/bake/extinction_law.h"
+#include "pine/bake/layer_field.h"
+#include "pine/vdbtrace/layer_bands.h"
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace pine::vdbtrace {
+namespace {
+
+using bake::Vec3;
+constexpr double kPi = 3.14159265358979323846;
+
+/// The transmittance of `layers` layers crossed one way at n needles a layer, cut into
+/// random spans.
+double acrossLayers(LayerBands& bands, double layers, double n, std::mt19937& rng, double sign)
+{
+    std::uniform_real_distribution<double> cut(0.0, 1.0);
+    std::vector<double> at{0.0, layers};
+    for (int i = 0; i < 7; ++i) at.push_back(layers * cut(rng));
+    std::sort(at.begin(), at.end());
+    double T = 1.0;
+    for (std::size_t i = 1; i < at.size(); ++i) {
+        const double k = at[i] - at[i - 1];
+        T *= bands.span(n * k, sign * k);
+    }
+    return T;
+}
+
+TEST(LayerBands, WholeLayersStopALineAsEvenlySpacedNeedlesDo)
+{
+    // K whole layers crossed one way, n needles met in each: (1 - n)^K, where a Poisson
+    // medium would give exp(-n K); the cut into spans changes nothing.
+    std::mt19937 rng(3);
+    for (const double n : {0.05, 0.3, 0.75, 0.99}) {
+        for (const int K : {1, 2, 5}) {
+            for (const double sign : {1.0, -1.0}) {
+                LayerBands bands;
+                EXPECT_NEAR(acrossLayers(bands, K, n, rng, sign), std::pow(1.0 - n, K), 1e-12)
+                    << "n " << n << " K " << K;
+            }
+        }
+    }
+}
+
+TEST(LayerBands, ABandEndsWhereTheLineTurnsBackOrLeavesTheMedium)
+{
+    std::mt19937 rng(5);
+    const double n = 0.6;
+    {
+        // Half a layer up, half a layer back down: two bands of n / 2 each.
+        LayerBands bands;
+        const double T = acrossLayers(bands, 0.5, n, rng, 1.0) *
+                         acrossLayers(bands, 0.5, n, rng, -1.0);
+        EXPECT_NEAR(T, (1.0 - n / 2) * (1.0 - n / 2), 1e-12);
+    }
+    {
+        // Half a layer, out of the medium, half a layer: two bands too.
+        LayerBands bands;
+        double T = acrossLayers(bands, 0.5, n, rng, 1.0);
+        EXPECT_EQ(bands.span(0.0, 0.0), 1.0);
+        T *= acrossLayers(bands, 0.5, n, rng, 1.0);
+        EXPECT_NEAR(T, (1.0 - n / 2) * (1.0 - n / 2), 1e-12);
+    }
+    {
+        // Along the layers (grazing) the needles add up in one band until it is opaque.
+        LayerBands bands;
+        EXPECT_NEAR(bands.span(0.3, 0.0) * bands.span(0.3, 0.0), 0.4, 1e-12);
+        EXPECT_EQ(bands.span(0.5, 0.0), 0.0);
+    }
+    {
+        // More needles than one band can hold: opaque, never negative or NaN.
+        LayerBands bands;
+        EXPECT_EQ(bands.span(3.0, 0.2), 0.0);
+        EXPECT_EQ(bands.span(1e300, 1e-300), 0.0);
+    }
+}
+
+TEST(LayerBands, OneCrossingOfAPaperBoughStopsALineWithItsNeedlesProjectedWidth)
+{
+    // From the bough's own geometry, not the sampled fields: the needles of the cone through x
+    // point along a = cos(phi) axis + sin(phi) radial, its normal is m = sin(phi) axis -
+    // cos(phi) radial, the cones are dh sin(phi) apart along m, and N needles fanning out
+    // from the apex cover N r / (pi rho) of the cone. A line along d crosses one layer over a
+    // path dh sin(phi) / |d . m| and meets n = coverage |d x a| / |d . m| needles there
+    // (A s_v / |n . d|, errata E13); the fibre law with its bands lets 1 - n through, the
+    // Poisson law exp(-n).
+    const Vec3 axis = glm::normalize(Vec3(0.2, -0.4, 0.9));
+    const Vec3 radial = glm::normalize(glm::cross(axis, Vec3(1.0, 0.0, 0.0)));
+    bake::BoughSpec b;
+    b.base_cm = Vec3(1.0, -2.0, 0.5);
+    b.tip_cm = b.base_cm + 40.0 * axis;
+    b.needles.cone = {kPi / 8, 4.25, 0.05, 12};
+    b.needles.coneSpacing_cm = 0.9;
+    const double phi = kPi / 8, dh = 0.9;
+    const Vec3 a = std::cos(phi) * axis + std::sin(phi) * radial;
+    const Vec3 m = std::sin(phi) * axis - std::cos(phi) * radial;
+    const bake::ExtinctionLaw& fibre = bake::extinctionLaw("fibre");
+    const bake::ExtinctionLaw& poisson = bake::extinctionLaw("poisson");
+    ASSERT_TRUE(fibre.banded());
+    ASSERT_FALSE(poisson.banded());
+    std::mt19937 rng(7);
+    std::normal_distribution<double> g;
+    int checked = 0;
+    for (const double rho : {0.3, 0.9, 1.5}) {
+        const auto s = bake::sampleBough(b, b.base_cm + 20.0 * axis + rho * radial);
+        ASSERT_TRUE(s);
+        const double coverage = std::min(1.0, 12 * 0.05 / (kPi * rho));
+        // Both laws write the rate's mean, the needles' mean projected area per volume.
+        EXPECT_EQ(fibre.meanExtinction(*s), poisson.meanExtinction(*s));
+        for (int i = 0; i < 300; ++i) {
+            const Vec3 d = glm::normalize(Vec3(g(rng), g(rng), g(rng)));
+            const double path = dh * std::sin(phi) / std::abs(glm::dot(d, m));
+            const double n = coverage * glm::length(glm::cross(d, a)) / std::abs(glm::dot(d, m));
+            if (!(n < 1.0) || !(path < 100.0)) continue;
+            ++checked;
+            const double rate = fibre.extinction(*s, d);
+            EXPECT_NEAR(rate, poisson.extinction(*s, d), 1e-12);
+            LayerBands bands;
+            const double layers = glm::dot(d, s->gradient) * path;
+            EXPECT_NEAR(std::abs(layers), 1.0, 1e-9);
+            EXPECT_NEAR(bands.span(rate * path, layers), 1.0 - n, 1e-9) << "rho " << rho;
+            EXPECT_NEAR(std::exp(-poisson.extinction(*s, d) * path), std::exp(-n), 1e-9);
+        }
+    }
+    EXPECT_GT(checked, 500);
+}
+
+}  // namespace
+}  // namespace pine::vdbtrace

@@ -1,0 +1,70 @@
+// Evenly spaced needles along a line through a baked field (the "fibre" extinction law, errata
+// E13): a line meets one cone's needles over a band, the part of it within one layer of that
+// cone on which the layer coordinate g / dh moves one way (cone_crossings.h draws the same
+// bands on the true cones). If it meets n needles on average there, evenly spaced thin needles
+// stop it with probability min(1, n), where a Poisson medium would let exp(-n) through.
+//
+// A voxel's field does not say where its cone lies, so the bands are drawn from where the line
+// enters the medium: a band ends where d . G changes sign (the line turns back through the
+// layers, as where it grazes a cone) or once it has crossed one whole layer.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+namespace pine::vdbtrace {
+
+class LayerBands {
+public:
+    /// The transmittance of the next span of the line, over which it meets `needles` needles
+    /// on average (the law's rate times the span's length) and crosses `layers` layers (signed:
+    /// d . G times the length), both uniform along the span. Spans must follow one another.
+    double span(double needles, double layers)
+    {
+        if (!(needles > 0.0)) {
+            mCrossed = 1.0;  // outside the medium, or between boughs: the next span begins one
+            return 1.0;
+        }
+        const double sign = layers < 0.0 ? -1.0 : 1.0;
+        if (sign != mSign) {
+            mSign = sign;
+            mCrossed = 1.0;  // the line turned back through the layers: a new band
+        }
+        const double crossings = std::abs(layers);
+        if (!(crossings > 0.0)) {  // along the layers: within one band
+            if (mCrossed >= 1.0) begin();
+            return stretch(needles);
+        }
+        const double perLayer = needles / crossings;
+        double left = crossings, T = 1.0;
+        while (left > 0.0 && T > 0.0) {
+            if (mCrossed >= 1.0) begin();
+            const double step = std::min(left, 1.0 - mCrossed);
+            T *= stretch(perLayer * step);
+            mCrossed += step;
+            left -= step;
+        }
+        return T;
+    }
+
+private:
+    void begin()
+    {
+        mCrossed = 0.0;
+        mNeedles = 0.0;
+    }
+    /// The band's transmittance from mNeedles to mNeedles + more, then mNeedles advanced.
+    double stretch(double more)
+    {
+        const double before = 1.0 - std::min(1.0, mNeedles);
+        mNeedles += more;
+        const double after = 1.0 - std::min(1.0, mNeedles);
+        return before > 0.0 ? after / before : 0.0;
+    }
+
+    double mNeedles = 0.0;  ///< met in the current band so far
+    double mCrossed = 1.0;  ///< layers crossed in the current band; 1: none begun
+    double mSign = 0.0;     ///< of d . G in the current band
+};
+
+}  // namespace pine::vdbtrace
