@@ -3,7 +3,9 @@
 # and the paper forest at 320 x 240 with self-shadowing added to their effects, rendered by the
 # geometry method (64 spp, the truth), by the multiscale method with the faithful models (the
 # default) and with --paper. Prints, per render, the foliage coverage (mean of the foliage
-# AOV) and the foliage-weighted luminance (sum of luminance x foliage over sum of foliage).
+# AOV) and the foliage-weighted luminance (sum of luminance x foliage over sum of foliage), for
+# the whole image and per tree (`vdbtrace diff` over the truth's "tree" AOV: the median and the
+# worst tree's bias, and how many trees are off by more than 3%).
 #
 #   bash scripts/faithful_report.sh [DIR]     renders into DIR (default: a temporary folder)
 #
@@ -30,6 +32,21 @@ measure() {
                --ch foliage.Y --mul --printstats | awk '/Stats Avg/ {print $3}')
   /usr/bin/python3 -c "print('%.5f %.5f' % ($coverage, $weighted / $coverage))"
 }
+per_tree() {  # errors.json of `vdbtrace diff`: per-tree biases, summarised
+  /usr/bin/python3 - "$1" <<'PY'
+import json, statistics, sys
+rows = json.load(open(sys.argv[1])).get("trees", [])
+if not rows:
+    print("   (no trees)")
+    sys.exit()
+for key in ("coverage_bias", "luminance_bias"):
+    b = [r[key] for r in rows]
+    worst = max(rows, key=lambda r: abs(r[key]))
+    off = sum(abs(x) > 0.03 for x in b)
+    print("   per tree %-15s median %+6.1f%%  worst %+6.1f%% (tree %d)  off by >3%%: %d of %d"
+          % (key, 100 * statistics.median(b), 100 * worst[key], worst["tree"], off, len(b)))
+PY
+}
 printf '%-14s %-10s %9s %9s %9s %9s\n' scene render coverage vs_truth luminance vs_truth
 for name in three-firs paper-forest; do
   scene="$out/$name.json"
@@ -40,6 +57,10 @@ for name in three-firs paper-forest; do
   for render in truth faithful paper; do
     read -r c l < <(measure "$out/$name.$render.exr")
     /usr/bin/python3 -c "print('%-14s %-10s %9.5f %+8.1f%% %9.5f %+8.1f%%' % ('$name', '$render', $c, 100 * ($c / $tc - 1), $l, 100 * ($l / $tl - 1)))"
+    if [ "$render" != truth ]; then
+      "$bin" diff "$out/$name.$render.exr" "$out/$name.truth.exr" --out "$out/$name.$render.diff" 2>/dev/null
+      per_tree "$out/$name.$render.diff/errors.json"
+    fi
   done
 done
 echo "faithful_report: images in $out" >&2

@@ -32,11 +32,11 @@ public:
         const std::string rate =
             "needles met per cm along d: needle_coverage |d x needle_direction| "
             "|layer_gradient|; ";
-        return rate + (mEvenlySpaced
-                           ? "each band of one layer along the line (d . layer_gradient of one "
-                             "sign, at most one layer) stopping it with probability min(1, "
-                             "needles met there); "
-                           : "sigma(d) = that rate; ") +
+        return rate +
+               (mEvenlySpaced ? "each band of one layer along the line (d . layer_gradient of one "
+                                "sign, at most one layer) stopping it with probability min(1, "
+                                "needles met there); "
+                              : "sigma(d) = that rate; ") +
                "density = mean rate / pine:density_scale_per_cm";
     }
     double extinction(const LayerSample& field, const Vec3& d) const override

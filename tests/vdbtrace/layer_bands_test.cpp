@@ -2,12 +2,12 @@
 // needles stop a line at each layer it crosses with probability n, the needles' projected
 // width there, however the line is cut into voxel spans; a band ends where the line turns
 // back through the layers or leaves the medium.
+#include "pine/vdbtrace/layer_bands.h"
 #include "pine/bake/extinction_law.h"
 #include "pine/bake/layer_field.h"
-#include "pine/vdbtrace/layer_bands.h"
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -59,8 +59,8 @@ TEST(LayerBands, ABandEndsWhereTheLineTurnsBackOrLeavesTheMedium)
     {
         // Half a layer up, half a layer back down: two bands of n / 2 each.
         LayerBands bands;
-        const double T = acrossLayers(bands, 0.5, n, rng, 1.0) *
-                         acrossLayers(bands, 0.5, n, rng, -1.0);
+        const double T =
+            acrossLayers(bands, 0.5, n, rng, 1.0) * acrossLayers(bands, 0.5, n, rng, -1.0);
         EXPECT_NEAR(T, (1.0 - n / 2) * (1.0 - n / 2), 1e-12);
     }
     {

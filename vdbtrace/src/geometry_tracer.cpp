@@ -353,6 +353,7 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     // What the hit is and how it reflects.
     Vec3 N = groundNormal, albedo = mScene.scene->ground.albedo;
     double weight = 0.0, exponent = 1.0;
+    int tree = -1;
     const bool isNeedle = cylinder && ctx.geomID == mNeedles.geomID;
     if (cylinder) {
         const CylinderSet& set = isNeedle ? mNeedles : mBranches;
@@ -360,18 +361,20 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
         N = cylinderNormal(c, x, ray.direction, ctx.cap);
         if (isNeedle) {
             const TracedBough& b = mScene.boughs[c.owner];
+            tree = b.tree;
             albedo = b.needleAlbedo;
             weight = b.specularWeight;
             exponent = b.exponent;
             ++mStats.needleHits;
         } else {
             albedo = mScene.branches[c.owner].albedo;
+            tree = mScene.branches[c.owner].tree;
             ++mStats.branchHits;
         }
     } else {
         ++mStats.groundHits;
     }
-    Fragment f{t, 1.0, Vec3(0.0), Vec3(0.0), 0, isNeedle};
+    Fragment f{t, 1.0, Vec3(0.0), Vec3(0.0), 0, isNeedle, tree};
     const bool shadeSpecular = mPlan.specular && isNeedle;
 
     for (const Light& light : mScene.lights) {

@@ -150,7 +150,7 @@ void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
     const Vec3 V = -ray.direction;
     for (std::size_t h = 0; h < hits; ++h) {
         const NeedleHit& n = mNeedleHits[h];
-        Fragment f{n.t, n.alpha, Vec3(0.0), Vec3(0.0), level, true};
+        Fragment f{n.t, n.alpha, Vec3(0.0), Vec3(0.0), level, true, b.tree};
         for (std::size_t i = 0; i < lights; ++i) {
             const Vec3 E = mLight[i].irradiance * mSelf[h * lights + i];
             const Vec3& L = mLight[i].towards;
@@ -300,7 +300,8 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     mFragments.push_back(Fragment{t, (1.0 - u) * lo.alpha + u * hi.alpha,
                                   (1.0 - u) * lo.diffuse + u * hi.diffuse,
                                   (1.0 - u) * lo.specular + u * hi.specular,
-                                  int(u < 0.5 ? blend.lower : blend.upper), true});
+                                  int(u < 0.5 ? blend.lower : blend.upper), true,
+                                  mScene.bough(index).tree});
 }
 
 void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Level level,
@@ -343,8 +344,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         return behindFront > 1e-9 ? profile.overFootprint(xi, R, w) / behindFront : 0.0;
     };
     const double tMid = 0.5 * (tIn + tOut);
-    Fragment front{tIn, frontAlpha, Vec3(0.0), Vec3(0.0), 3, true};
-    Fragment rear{tMid, rearPart(b.alpha.rear), Vec3(0.0), Vec3(0.0), 3, true};
+    Fragment front{tIn, frontAlpha, Vec3(0.0), Vec3(0.0), 3, true, b.tree};
+    Fragment rear{tMid, rearPart(b.alpha.rear), Vec3(0.0), Vec3(0.0), 3, true, b.tree};
     // The light at the chord's middle, or with shadow_origin "axis" where the ray passes the
     // axis.
     const double tLight = mScene.shadowsFromNeedles ? tMid : p.t;

@@ -101,7 +101,7 @@ bool SurfaceShading::branch(const ConeRay& ray, std::size_t index, double tMax, 
     intersectCylinder(ray, br.base_cm, br.tip_cm, br.radius_cm, tIn, tOut);
     if (tIn > tMax) return false;  // behind the ground: hidden, not worth its shadow rays
     ++mStats.branchHits;
-    out = Fragment{tIn, c, Vec3(0.0), Vec3(0.0), 0, false};
+    out = Fragment{tIn, c, Vec3(0.0), Vec3(0.0), 0, false, br.tree};
     if (!mPlan.diffuse) return true;
     const Vec3 axis = glm::normalize(br.tip_cm - br.base_cm);
     for (const Incident& light : lightAt(ray.origin + p.t * ray.direction, w, index)) {

@@ -98,6 +98,7 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
     b.conesEnd_cm = b.tip_cm + cone.needleLength_cm * std::cos(cone.aperture_rad) * b.axis;
     b.needleAlbedo = d.spec.needleAlbedo;
     b.specularWeight = d.specularWeight;
+    b.tree = d.tree;
     b.exponent = d.exponent;
     b.seed = d.seed;
 
@@ -176,7 +177,8 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
         const scenes::Tree& tree = out.trees[i];
         const scenes::Species& species = *tree.species;
         for (const scenes::Segment& s : tree.segments) {
-            out.branches.push_back({s.base_cm, s.tip_cm, s.radius_cm, scenes::barkColour(species)});
+            out.branches.push_back(
+                {s.base_cm, s.tip_cm, s.radius_cm, scenes::barkColour(species), int(i)});
         }
         const std::vector<bake::BoughSpec> specs = bake::treeBoughs(tree);
         for (std::size_t j = 0; j < specs.size(); ++j) {
@@ -186,6 +188,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
             d.specularWeight = species.needleSpecular;
             d.exponent = species.specularExponent;
             d.seed = unsigned(i * 7919u + j * 104729u + scene.trees[i].seed);
+            d.tree = int(i);
             boughs.push_back(d);
         }
     }

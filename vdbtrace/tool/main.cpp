@@ -10,6 +10,7 @@
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
+#include "pine/vdbtrace/tree_foliage.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
@@ -23,6 +24,7 @@
 
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -290,9 +292,45 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
     j["image"] = a.string();
     j["reference"] = b.string();
     j["png_scale"] = shown;
+    // Per tree, over the reference's trees (its "tree" AOV), where both images say so.
+    std::string worst;
+    if (reference.aovs.count("tree") && reference.aovs.count("foliage") &&
+        image.aovs.count("foliage")) {
+        const std::vector<vdbtrace::TreeBias> trees = vdbtrace::treeBiases(image, reference);
+        nlohmann::json rows = nlohmann::json::array();
+        const vdbtrace::TreeBias* worstLuminance = nullptr;
+        const vdbtrace::TreeBias* worstCoverage = nullptr;
+        for (const vdbtrace::TreeBias& t : trees) {
+            rows.push_back({{"tree", t.truth.tree},
+                            {"pixels", t.truth.pixels},
+                            {"coverage", t.image.coverage},
+                            {"coverage_reference", t.truth.coverage},
+                            {"coverage_bias", t.coverageBias},
+                            {"luminance", t.image.luminance},
+                            {"luminance_reference", t.truth.luminance},
+                            {"luminance_bias", t.luminanceBias}});
+            if (!worstLuminance ||
+                std::abs(t.luminanceBias) > std::abs(worstLuminance->luminanceBias)) {
+                worstLuminance = &t;
+            }
+            if (!worstCoverage ||
+                std::abs(t.coverageBias) > std::abs(worstCoverage->coverageBias)) {
+                worstCoverage = &t;
+            }
+        }
+        j["trees"] = rows;
+        if (worstLuminance) {
+            std::ostringstream s;
+            s << "; " << trees.size() << " trees, worst luminance bias "
+              << 100.0 * worstLuminance->luminanceBias << "% (tree " << worstLuminance->truth.tree
+              << "), worst coverage bias " << 100.0 * worstCoverage->coverageBias << "% (tree "
+              << worstCoverage->truth.tree << ")";
+            worst = s.str();
+        }
+    }
     vdbtrace::writeJsonAtomically(j, outDir / "errors.json");
     std::cerr << "vdbtrace diff: rmse " << errors.rmse << ", mean relative " << errors.meanRelative
-              << ", max " << errors.maxAbsolute << " -> " << outDir.string()
+              << ", max " << errors.maxAbsolute << worst << " -> " << outDir.string()
               << " (error.exr, error.png scaled 0.." << shown << ", errors.json)\n";
     return 0;
 }

@@ -19,6 +19,55 @@ struct Fragment {
     Vec3 diffuse{0.0}, specular{0.0};  ///< radiance, premultiplied by alpha
     int level = 0;                     ///< 1-3: the multiscale level that shaded it; 0: none
     bool foliage = false;              ///< needles, at any scale: the "foliage" AOV
+    int tree = -1;  ///< the scene's tree (index of its placement) it belongs to; -1: none known
+};
+
+/// How much of a footprint each tree's foliage covers: a few trees, the largest kept.
+template <int Slots>
+struct TreeShares {
+    int tree[Slots];
+    double weight[Slots];
+    int count = 0;
+
+    void add(int id, double w)
+    {
+        if (id < 0 || !(w > 0.0)) return;
+        for (int k = 0; k < count; ++k) {
+            if (tree[k] == id) {
+                weight[k] += w;
+                return;
+            }
+        }
+        if (count < Slots) {
+            tree[count] = id;
+            weight[count++] = w;
+            return;
+        }
+        int least = 0;  // full: the new share replaces the smallest if larger
+        for (int k = 1; k < Slots; ++k) least = weight[k] < weight[least] ? k : least;
+        if (w > weight[least]) {
+            tree[least] = id;
+            weight[least] = w;
+        }
+    }
+    template <int Other>
+    void add(const TreeShares<Other>& other)
+    {
+        for (int k = 0; k < other.count; ++k) add(other.tree[k], other.weight[k]);
+    }
+    /// The tree of the largest share, -1 if none.
+    int dominant() const
+    {
+        int best = -1;
+        double most = 0.0;
+        for (int k = 0; k < count; ++k) {
+            if (weight[k] > most || (weight[k] == most && tree[k] < best)) {
+                most = weight[k];
+                best = tree[k];
+            }
+        }
+        return best;
+    }
 };
 
 /// One camera ray's fragments composited, front to back.
@@ -28,6 +77,7 @@ struct SampleValue {
     double foliage = 0.0;              ///< the part of alpha that foliage fragments gave
     double levelWeight[4] = {0.0, 0.0, 0.0, 0.0};  ///< the part each level gave (0: none)
     double levelSum = 0.0;             ///< sum over fragments of their part times level
+    TreeShares<4> trees;               ///< the part of foliage each tree gave
     /// Where the accumulated coverage passes 1/2 (the fragment's t), infinite if it never does.
     double depth = std::numeric_limits<double>::infinity();
 };
@@ -44,7 +94,10 @@ public:
         const double weight = (1.0 - mValue.alpha) * f.alpha;
         mValue.diffuse += (1.0 - mValue.alpha) * f.diffuse;
         mValue.specular += (1.0 - mValue.alpha) * f.specular;
-        if (f.foliage) mValue.foliage += weight;
+        if (f.foliage) {
+            mValue.foliage += weight;
+            mValue.trees.add(f.tree, weight);
+        }
         if (f.level > 0) {
             mValue.levelSum += weight * f.level;
             mValue.levelWeight[f.level] += weight;

@@ -11,8 +11,11 @@ namespace pine::vdbtrace {
 /// The AOVs every render writes beside RGBA, one float per pixel each (docs/vdbtrace.md):
 /// "level" (coverage-weighted multiscale level in [1, 3], 0 where none shaded the pixel),
 /// "depth" (cm, where the pixel's coverage passes 1/2; 0 where it never does), "diffuse" and
-/// "specular" (luminance of each term), "foliage" (coverage by needles, at any scale).
-inline constexpr const char* kAovNames[] = {"level", "depth", "diffuse", "specular", "foliage"};
+/// "specular" (luminance of each term), "foliage" (coverage by needles, at any scale), "tree"
+/// (the index in the scene's trees of the tree whose foliage covers most of the pixel, -1
+/// where none does or the method does not know: the reference's merged grids).
+inline constexpr const char* kAovNames[] = {"level",   "depth",   "diffuse",
+                                            "specular", "foliage", "tree"};
 
 struct RenderOptions {
     int tileSize = 16;  ///< pixels along each side of a tile, the unit of parallel work

@@ -39,6 +39,7 @@ struct TracedBranch {
     Vec3 base_cm, tip_cm;
     double radius_cm = 0.1;
     Vec3 albedo{0.25};
+    int tree = -1;  ///< index of its tree in the scene's trees
 };
 
 /// What a bough looks like from one light with the camera where it is (section 6 inputs).
@@ -55,6 +56,7 @@ struct BoughDescription {
     double specularWeight = 0.0;
     double exponent = 100.0;
     unsigned seed = 0;  ///< drives the needles' azimuths (needle_layout.h)
+    int tree = -1;      ///< index of its tree in the scene's trees
 };
 
 struct TracedBough {
@@ -79,6 +81,7 @@ struct TracedBough {
     RearComposite rearComposite = RearComposite::Own;  ///< how the law's rear half composites
     bool shadesNeedles = false;  ///< level 3 reflects the law's diffuse and specular profiles
     unsigned seed = 0;          ///< drives the needles' azimuths at level 1
+    int tree = -1;              ///< index of its tree in the scene's trees
     std::vector<BoughLighting> lighting;  ///< one per light
 };
 

@@ -1,0 +1,99 @@
+#include "pine/vdbtrace/tree_foliage.h"
+
+#include "pine/vdbtrace/fragment.h"
+
+#include <cmath>
+#include <deque>
+#include <map>
+#include <string>
+
+namespace pine::vdbtrace {
+namespace {
+
+const std::vector<float>& plane(const Image& image, const char* name)
+{
+    const auto it = image.aovs.find(name);
+    if (it == image.aovs.end() || it->second.size() != std::size_t(image.width) * image.height) {
+        throw ImageError(std::string("the image has no \"") + name + "\" AOV");
+    }
+    return it->second;
+}
+
+}  // namespace
+
+std::vector<int> treeRegions(const Image& segmentation)
+{
+    const std::vector<float>& tree = plane(segmentation, "tree");
+    const int w = segmentation.width, h = segmentation.height;
+    std::vector<int> region(tree.size(), -1);
+    // Breadth first from every named pixel at once, in scanline order: a pixel takes the tree
+    // that reaches it first.
+    std::deque<std::size_t> queue;
+    for (std::size_t i = 0; i < tree.size(); ++i) {
+        if (tree[i] >= 0.0f) {
+            region[i] = int(std::lround(tree[i]));
+            queue.push_back(i);
+        }
+    }
+    while (!queue.empty()) {
+        const std::size_t i = queue.front();
+        queue.pop_front();
+        const int x = int(i % std::size_t(w)), y = int(i / std::size_t(w));
+        const int nx[4] = {x - 1, x + 1, x, x};
+        const int ny[4] = {y, y, y - 1, y + 1};
+        for (int k = 0; k < 4; ++k) {
+            if (nx[k] < 0 || ny[k] < 0 || nx[k] >= w || ny[k] >= h) continue;
+            const std::size_t j = std::size_t(ny[k]) * std::size_t(w) + std::size_t(nx[k]);
+            if (region[j] >= 0) continue;
+            region[j] = region[i];
+            queue.push_back(j);
+        }
+    }
+    return region;
+}
+
+std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int>& regions)
+{
+    const std::vector<float>& foliage = plane(image, "foliage");
+    if (regions.size() != foliage.size()) {
+        throw ImageError("tree regions of " + std::to_string(regions.size()) +
+                         " pixels for an image of " + std::to_string(foliage.size()));
+    }
+    std::map<int, TreeFoliage> trees;
+    std::map<int, double> weighted;
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+        if (regions[i] < 0) continue;
+        TreeFoliage& t = trees[regions[i]];
+        t.tree = regions[i];
+        ++t.pixels;
+        const float* p = &image.rgba[4 * i];
+        t.coverage += foliage[i];
+        weighted[regions[i]] += luminance(Vec3(p[0], p[1], p[2])) * foliage[i];
+    }
+    std::vector<TreeFoliage> out;
+    for (auto& [id, t] : trees) {
+        t.luminance = t.coverage > 0.0 ? weighted[id] / t.coverage : 0.0;
+        out.push_back(t);
+    }
+    return out;
+}
+
+std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double minCoverage)
+{
+    if (image.width != truth.width || image.height != truth.height) {
+        throw ImageError("images differ in size");
+    }
+    const std::vector<int> regions = treeRegions(truth);
+    const std::vector<TreeFoliage> a = foliageByTree(image, regions);
+    const std::vector<TreeFoliage> b = foliageByTree(truth, regions);
+    std::vector<TreeBias> out;
+    for (std::size_t k = 0; k < b.size(); ++k) {  // the same regions, so the same trees
+        if (!(b[k].coverage >= minCoverage)) continue;
+        TreeBias t{a[k], b[k], a[k].coverage / b[k].coverage - 1.0,
+                   b[k].luminance > 0.0 ? a[k].luminance / b[k].luminance - 1.0 : 0.0};
+        out.push_back(t);
+    }
+    return out;
+}
+
+}  // namespace pine::vdbtrace
