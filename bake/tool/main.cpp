@@ -68,6 +68,7 @@ int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& commo
 {
     const auto start = std::chrono::steady_clock::now();
     io::checkWritable(out);  // before the work, not after it
+    io::checkOutputsApart({out, out.string() + ".json"}, {sceneFile});
     const scenes::Scene scene = scenes::loadScene(sceneFile);
     const bake::BakeSettings settings = forScene(common, law, scene);
     if (tree < 0 || std::size_t(tree) >= scene.trees.size()) {
@@ -96,6 +97,9 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
     const scenes::Scene scene = scenes::loadScene(sceneFile);
     const bake::BakeSettings settings = forScene(common, law, scene);
     const std::size_t n = scene.trees.size();
+    for (std::size_t i = 0; i < n; ++i) {  // the names differ; the scene may be among them
+        io::checkOutputsApart({treeFile(dir, i), treeFile(dir, i).string() + ".json"}, {sceneFile});
+    }
     Totals totals;
     std::mutex progress;
     // Trees in parallel, one task each; bakeBoughs also splits a tree's boughs among threads.

@@ -1,5 +1,8 @@
 #include "pine/support/atomic_file.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -17,8 +20,12 @@ fs::path temporaryBeside(const fs::path& file)
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(rng()));
     const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    // ".NAME.tmp-HEX" within NAME_MAX (255 bytes on Linux): NAME shortened if need be.
+    constexpr std::size_t kNameMax = 255, kAdded = 1 + 5 + 16;
+    std::string base = file.filename().string();
+    if (base.size() > kNameMax - kAdded) base.resize(kNameMax - kAdded);
     std::string name = ".";  // built in steps: GCC 12's -Wrestrict misfires on "." + string
-    name += file.filename().string();
+    name += base;
     name += ".tmp-";
     name += hex;
     return folder / name;
@@ -43,6 +50,14 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
         fs::remove(tmp, ignored);
         throw;
     }
+    // The bytes on the disk before the name: a full disk fails here, not after the rename.
+    const int fd = ::open(tmp.c_str(), O_RDONLY);
+    if (fd < 0 || ::fsync(fd) != 0) {
+        const int why = errno;
+        if (fd >= 0) ::close(fd);
+        throw refuse(std::strerror(why));
+    }
+    ::close(fd);
     std::error_code error;
     fs::rename(tmp, file, error);
     if (error) throw refuse(error.message());
@@ -84,8 +99,43 @@ void checkWritable(const fs::path& file)
     if (file.empty() || !file.has_filename()) throw refuse("no file name");
     std::error_code error;
     if (fs::is_directory(file, error)) throw refuse("it is a folder");
+    const fs::file_status status = fs::status(file, error);
+    if (fs::exists(status) && !fs::is_regular_file(status)) {
+        throw refuse("it is not a regular file (a device, a pipe or a socket)");
+    }
     const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
     if (const std::string why = probeFolder(folder, file); !why.empty()) throw refuse(why);
+}
+
+bool sameFile(const fs::path& a, const fs::path& b)
+{
+    std::error_code error;
+    if (fs::exists(a, error) && fs::exists(b, error)) {
+        const bool same = fs::equivalent(a, b, error);
+        if (!error) return same;
+    }
+    const fs::path ca = fs::weakly_canonical(fs::absolute(a, error), error);
+    const fs::path cb = fs::weakly_canonical(fs::absolute(b, error), error);
+    return ca == cb;
+}
+
+void checkOutputsApart(const std::vector<fs::path>& outputs, const std::vector<fs::path>& inputs)
+{
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+        if (outputs[i].empty()) continue;
+        for (const fs::path& in : inputs) {
+            if (!in.empty() && sameFile(outputs[i], in)) {
+                throw InputError("cannot write '" + outputs[i].string() +
+                                 "': it is also an input of this run ('" + in.string() + "')");
+            }
+        }
+        for (std::size_t j = 0; j < i; ++j) {
+            if (!outputs[j].empty() && sameFile(outputs[i], outputs[j])) {
+                throw InputError("cannot write '" + outputs[i].string() + "' and '" +
+                                 outputs[j].string() + "': they are the same file");
+            }
+        }
+    }
 }
 
 void checkWritableFolder(const fs::path& folder)

@@ -6,6 +6,7 @@
 #include <tbb/global_control.h>
 
 #include <iostream>
+#include <new>
 #include <string>
 #include <memory>
 
@@ -46,6 +47,11 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
         return body();
     } catch (const InputError& e) {
         std::cerr << name << ": " << oneLine(e.what()) << '\n';
+        return 2;
+    } catch (const std::bad_alloc&) {
+        std::cerr << name << ": out of memory: the scene or the settings ask for more than this "
+                             "machine has (lower the resolution, the samples, the trees or the "
+                             "voxel size)\n";
         return 2;
     } catch (const std::exception& e) {
         std::cerr << name << ": " << oneLine(e.what()) << '\n';

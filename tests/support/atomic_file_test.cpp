@@ -80,5 +80,59 @@ TEST(AtomicFile, CheckWritableFolderCreatesItOrSaysWhyNot)
     EXPECT_THROW(checkWritableFolder("/proc/no-such-dir"), InputError);
 }
 
+TEST(AtomicFile, ANameNearTheLongestAllowedIsWrittenNotRefused)
+{
+    // The temporary adds 22 bytes to the name: it must still fit in NAME_MAX (255).
+    const test::TempDir dir;
+    const fs::path file = dir.path() / (std::string(250, 'n') + ".exr");
+    EXPECT_LE(temporaryBeside(file).filename().string().size(), 255u);
+    EXPECT_EQ(temporaryBeside(file).parent_path(), file.parent_path());
+    writeTextAtomically(file, "long");
+    EXPECT_EQ(readFile(file), "long");
+    EXPECT_EQ(listing(dir.path()).size(), 1u);
+}
+
+TEST(AtomicFile, ADeviceIsNotAnOutput)
+{
+    // A rename onto /dev/null would replace the device node with a regular file.
+    try {
+        checkWritable("/dev/null");
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+    }
+}
+
+TEST(AtomicFile, OutputsApartFromInputsAndFromEachOther)
+{
+    const test::TempDir dir;
+    const fs::path scene = dir.write("scene.json", "{}");
+    fs::create_directories(dir.path() / "sub");
+    const fs::path out = dir.path() / "out.exr";
+    EXPECT_NO_THROW(checkOutputsApart({out, dir.path() / "out.png", {}}, {scene}));
+    // The same file under other names: "..", a hard link, a symbolic link.
+    const fs::path viaDots = dir.path() / "sub" / ".." / "scene.json";
+    const fs::path hard = dir.path() / "hard.json";
+    const fs::path soft = dir.path() / "soft.json";
+    fs::create_hard_link(scene, hard);
+    fs::create_symlink(scene, soft);
+    for (const fs::path& alias : {scene, viaDots, hard, soft}) {
+        try {
+            checkOutputsApart({out, alias}, {scene});
+            ADD_FAILURE() << alias << " accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("also an input"), std::string::npos) << e.what();
+        }
+    }
+    // Two outputs, one file (neither exists yet).
+    try {
+        checkOutputsApart({out, dir.path() / "sub" / ".." / "out.exr"}, {});
+        ADD_FAILURE() << "two names of one output accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("the same file"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(readFile(scene), "{}");
+}
+
 }  // namespace
 }  // namespace pine::io

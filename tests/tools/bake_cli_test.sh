@@ -23,6 +23,14 @@ expect_error "negative voxel size" 2 "voxel-size" -- scene "$bough" --voxel-size
 expect_error "bad levels" 2 "levels" -- tree "$bough" --tree 0 --voxel-size 1 --levels 0 --out "$work/a.vdb"
 expect_error "missing option" 2 "out" -- tree "$bough" --tree 0 --voxel-size 1
 expect_error "no subcommand" 2 "subcommand" --
+# A scene in the output folder under a tree file's name is not baked over.
+mkdir "$work/inplace"
+cp "$bough" "$work/inplace/tree_000.vdb"
+expect_error "output is the scene" 2 "also an input" -- scene "$work/inplace/tree_000.vdb" --voxel-size 1 --out-dir "$work/inplace"
+expect_error "tree onto the scene" 2 "also an input" -- tree "$work/inplace/tree_000.vdb" --tree 0 --voxel-size 1 --out "$work/inplace/tree_000.vdb"
+cmp -s "$bough" "$work/inplace/tree_000.vdb" || fail "a refused bake changed the scene"
+[ "$(ls "$work/inplace")" = tree_000.vdb ] || fail "a refused bake left files: $(ls "$work/inplace")"
+rm -r "$work/inplace"
 [ -z "$(ls -A "$work" | grep -v -e '^out$' -e '^err$' -e '^broken.json$')" ] || fail "failed runs left files: $(ls -A "$work")"
 
 # One tree: the .vdb and its manifest; one summary line.

@@ -14,6 +14,22 @@ expect_error "malformed scene" 2 "broken.json:1:" -- render "$work/broken.json" 
 expect_error "unwritable output" 2 "no/such/dir" -- render "$src/scenes/bough.json" --out "$work/no/such/dir/a.exr"
 expect_error "unknown method" 2 "not available" -- render "$src/scenes/bough.json" --method nonsense --out "$work/a.exr"
 expect_error "bad option" 2 "force-level" -- render "$src/scenes/bough.json" --out "$work/a.exr" --force-level 7
+# Outputs that would destroy an input, each other or a device, and formats the name does not
+# say: refused before any work, the files left as they were.
+cp "$src/scenes/bough.json" "$work/scene.json"
+expect_error "output is the scene" 2 "must end in .exr" -- render "$work/scene.json" --out "$work/scene.json"
+cp "$src/scenes/bough.json" "$work/scene.exr"  # a scene's name says nothing of its format
+expect_error "output is the scene, named .exr" 2 "also an input" -- render "$work/scene.exr" --out "$work/scene.exr"
+cmp -s "$src/scenes/bough.json" "$work/scene.exr" || fail "a refused render changed the scene"
+rm "$work/scene.exr"
+expect_error "png output" 2 "must end in .exr" -- render "$work/scene.json" --out "$work/a.png"
+expect_error "stats onto the image" 2 "same file" -- render "$work/scene.json" --out "$work/a.exr" --stats "$work/a.exr"
+expect_error "stats onto the preview" 2 "same file" -- render "$work/scene.json" --out "$work/a.exr" --stats "$work/a.png"
+expect_error "stats onto the scene" 2 "also an input" -- render "$work/scene.json" --out "$work/a.exr" --stats "$work/scene.json"
+expect_error "device output" 2 "not a regular file" -- render "$work/scene.json" --out "$work/a.exr" --stats /dev/null
+cmp -s "$src/scenes/bough.json" "$work/scene.json" || fail "a refused render changed the scene"
+[ -c /dev/null ] || fail "/dev/null is no longer a device"
+rm "$work/scene.json"
 [ -z "$(ls "$work" | grep -v -e '^out$' -e '^err$' -e '^broken.json$')" ] || fail "failed runs left files: $(ls "$work")"
 
 # An existing output survives a failed render.

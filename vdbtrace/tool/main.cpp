@@ -23,6 +23,8 @@
 #include <tbb/task_arena.h>
 
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -130,8 +132,24 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
            const ModelOverrides& model)
 {
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
+    // The extension decides the format: only EXR holds the render (its PNG goes beside it).
+    std::string extension = out.extension().string();
+    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".exr") {
+        throw InputError("--out '" + out.string() + "': the render is written as OpenEXR and " +
+                         "its name must end in .exr (a PNG preview is written beside it)");
+    }
     io::checkWritable(out);
     if (!statsFile.empty()) io::checkWritable(statsFile);
+    std::vector<fs::path> inputs = {sceneFile};
+    for (const fs::path& g : gridFiles) {
+        inputs.push_back(g);
+        inputs.push_back(g.string() + ".json");
+    }
+    const bool levelPng = std::find(aovs.begin(), aovs.end(), "level") != aovs.end();
+    io::checkOutputsApart({out, besideWith(out, ".png"),
+                           levelPng ? besideWith(out, ".level.png") : fs::path(), statsFile},
+                          inputs);
     // Baked files first: a damaged one is refused before any work.
     std::optional<bake::TreeGrids> baked;
     if (methodName == "reference" && !gridFiles.empty()) {

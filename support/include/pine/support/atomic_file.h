@@ -7,11 +7,13 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace pine::io {
 
 /// A fresh name for a temporary file beside `file` (hidden, in the same folder, so that the
-/// rename onto `file` is atomic).
+/// rename onto `file` is atomic), no longer than a file name may be (NAME_MAX): a long name is
+/// shortened in the temporary's, never refused for it.
 std::filesystem::path temporaryBeside(const std::filesystem::path& file);
 
 /// Writes `file` by calling write(temporary) on a temporary beside it, then renaming the
@@ -26,9 +28,20 @@ void writeAtomically(const std::filesystem::path& file,
 void writeTextAtomically(const std::filesystem::path& file, const std::string& text);
 
 /// Throws InputError (one line naming the path and why) unless a file can be created at
-/// `file`: it has a name, is not a folder, its folder exists and takes a new file (tried, not
+/// `file`: it has a name, is not a folder or another file that is not a regular one (a device,
+/// a pipe: a rename would replace it), its folder exists and takes a new file (tried, not
 /// guessed from permission bits: read-only mounts, ACLs and root all differ).
 void checkWritable(const std::filesystem::path& file);
+
+/// Whether two paths name the same file: the same file if both exist (hard and symbolic links
+/// followed), else the same path once made absolute and resolved ("..", links of the folders).
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
+
+/// Throws InputError (one line naming both paths) when an output of a run is one of its inputs
+/// or two outputs are the same file: the run would overwrite what it reads, or lose one
+/// output to the other. Empty paths are ignored.
+void checkOutputsApart(const std::vector<std::filesystem::path>& outputs,
+                       const std::vector<std::filesystem::path>& inputs);
 
 /// Creates `folder` (and its parents) if missing, then checkWritable of a file in it.
 void checkWritableFolder(const std::filesystem::path& folder);

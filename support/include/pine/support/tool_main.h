@@ -11,7 +11,8 @@ namespace pine::tool {
 /// Adds --threads to `app`, parses argv (--help prints and returns 0; a parse error prints one
 /// line "NAME: WHY (see --help)" and returns 2), limits TBB to the threads asked for, runs
 /// `body` and returns its status; what it throws becomes one line "NAME: WHAT" on stderr and
-/// status 2 for an InputError (the user's input or output), 1 for anything else.
+/// status 2 for an InputError (the user's input or output) and for running out of memory
+/// (std::bad_alloc: what was asked of the machine), 1 for anything else.
 int run(const char* name, CLI::App& app, int argc, char** argv,
         const std::function<int()>& body);
 
