@@ -125,10 +125,12 @@ Vec3 readVec3(const Json& v, const Where& where) { return readVector<3>(v, where
 Vec3 readDirection(const Json& v, const Where& where)
 {
     const Vec3 d = readVec3(v, where);
-    const double length = glm::length(d);
-    // A length that underflows to zero is as unusable as zero itself.
-    if (!(length > 0.0) || !std::isfinite(length)) where.fail("must not be a zero vector");
-    return d / length;
+    // Scaled by its largest component first, so that neither 1e-200 nor 1e200 under- or
+    // overflows the length: only a true zero vector has no direction.
+    const double largest = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+    if (!(largest > 0.0)) where.fail("must not be a zero vector");
+    const Vec3 scaled = d / largest;
+    return scaled / glm::length(scaled);
 }
 
 Vec3 readColour(const Json& v, const Where& where, const Range& range)

@@ -433,6 +433,24 @@ TEST(SceneParser, RejectsUnknownSpecies)
     expectError(j, "trees[2].scatter.species", "unknown species \"pine\"");
 }
 
+TEST(SceneParser, NormalisesTinyAndHugeDirections)
+{
+    // Only a true zero vector has no direction: 1e-200 and 1e200 (whose squared lengths under-
+    // and overflow) are directions like any other.
+    for (const double scale : {1e-200, 1e200, 1e-308, 1.7e308}) {
+        json j = fullScene();
+        j["lights"][1]["direction"] = {0.0, -0.6 * scale, 0.8 * scale};
+        j["camera"]["up"] = {0.0, 0.0, scale};
+        const Scene s = parseScene(j.dump(), "tiny.json");
+        ASSERT_EQ(s.directionalLights.size(), 1u) << scale;
+        const Vec3 d = s.directionalLights[0].towardsLight;
+        EXPECT_NEAR(d.x, 0.0, 1e-15) << scale;
+        EXPECT_NEAR(d.y, -0.6, 1e-15) << scale;
+        EXPECT_NEAR(d.z, 0.8, 1e-15) << scale;
+        EXPECT_NEAR(s.camera.up.z, 1.0, 1e-15) << scale;
+    }
+}
+
 TEST(SceneParser, RejectsZeroVectors)
 {
     json j = fullScene();

@@ -1,11 +1,13 @@
 #include "pine/vdbtrace/render_driver.h"
 
+#include "pine/support/input_error.h"
 #include "pine/vdbtrace/tiled_render.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iterator>
+#include <string>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -130,6 +132,14 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
         }
     });
     result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    // Finite inputs can still overflow (a light of 1e308): an error, never a NaN pixel.
+    std::size_t bad = 0;
+    for (const float v : image.rgba) bad += std::isfinite(v) ? 0 : 1;
+    if (bad > 0) {
+        throw InputError("radiance overflowed: " + std::to_string(bad) +
+                         " pixel values are not finite (a light too bright or too near a "
+                         "surface for float radiance)");
+    }
     return result;
 }
 

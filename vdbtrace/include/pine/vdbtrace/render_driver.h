@@ -35,7 +35,8 @@ public:
 /// Renders the scene's camera with `method`: every pixel the mean of its samples' composites
 /// (RGBA, diffuse, specular, foliage), its level the coverage-weighted mean level, its depth the
 /// ceil(S/2)-th nearest of its S samples' depths (where the pixel's coverage passes 1/2). The
-/// same image whatever the thread count. `result.seconds` is the loop's time alone.
+/// same image whatever the thread count. `result.seconds` is the loop's time alone. Throws
+/// InputError when a pixel's value is not finite (radiance overflowing float).
 RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
                          const RenderOptions& options);
 
