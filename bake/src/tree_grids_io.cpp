@@ -132,18 +132,25 @@ void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
         list.push_back(densityForWriting(*lod, grids.densityScale_per_cm, meta));
     }
 
-    // Written under a temporary name beside the target, then renamed: a crash or an error never
-    // leaves a half-written file under the final name (DESIGN.md).
+    // Written under a temporary name beside the target, synced, then renamed: a crash or an
+    // error never leaves a half-written file under the final name (DESIGN.md). The manifest
+    // goes in first: a grid under its final name always has its own manifest, or (killed
+    // between the two renames) a newer one that refuses it, never an older one that matches
+    // the file it replaced. What a killed bake left behind goes first.
+    io::removeStaleTemporaries(path);
+    io::removeStaleTemporaries(detail::manifestPath(path));
     detail::FileDigest digest;
     asBakeError([&] {
-        io::writeAtomically(path, [&](const fs::path& tmp) {
-            openvdb::io::File file(tmp.string());
-            file.write(list, meta);  // openvdb::Exception derives from std::exception
-            file.close();
-            digest = detail::digestFile(tmp);
-        });
+        io::writeAtomically(
+            path,
+            [&](const fs::path& tmp) {
+                openvdb::io::File file(tmp.string());
+                file.write(list, meta);  // openvdb::Exception derives from std::exception
+                file.close();
+                digest = detail::digestFile(tmp);
+            },
+            [&] { detail::writeManifest(path, digest); });
     });
-    detail::writeManifest(path, digest);
 }
 
 TreeGrids readTreeGrids(const fs::path& path)

@@ -14,6 +14,39 @@ namespace pine::io {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// ".NAME.tmp-": what every temporary of `file` begins with, NAME shortened to fit NAME_MAX.
+std::string temporaryPrefix(const fs::path& file)
+{
+    constexpr std::size_t kNameMax = 255, kAdded = 1 + 5 + 16;
+    std::string base = file.filename().string();
+    if (base.size() > kNameMax - kAdded) base.resize(kNameMax - kAdded);
+    std::string name = ".";  // built in steps: GCC 12's -Wrestrict misfires on "." + string
+    name += base;
+    name += ".tmp-";
+    return name;
+}
+
+}  // namespace
+
+int removeStaleTemporaries(const fs::path& file)
+{
+    const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    const std::string prefix = temporaryPrefix(file);
+    std::error_code error;
+    int removed = 0;
+    for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+        const std::string name = it->path().filename().string();
+        if (name.size() == prefix.size() + 16 && name.compare(0, prefix.size(), prefix) == 0 &&
+            it->is_regular_file(error)) {
+            std::error_code ignored;
+            if (fs::remove(it->path(), ignored)) ++removed;
+        }
+    }
+    return removed;
+}
+
 fs::path temporaryBeside(const fs::path& file)
 {
     static thread_local std::mt19937_64 rng{std::random_device{}()};
@@ -21,17 +54,11 @@ fs::path temporaryBeside(const fs::path& file)
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(rng()));
     const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
     // ".NAME.tmp-HEX" within NAME_MAX (255 bytes on Linux): NAME shortened if need be.
-    constexpr std::size_t kNameMax = 255, kAdded = 1 + 5 + 16;
-    std::string base = file.filename().string();
-    if (base.size() > kNameMax - kAdded) base.resize(kNameMax - kAdded);
-    std::string name = ".";  // built in steps: GCC 12's -Wrestrict misfires on "." + string
-    name += base;
-    name += ".tmp-";
-    name += hex;
-    return folder / name;
+    return folder / (temporaryPrefix(file) + hex);
 }
 
-void writeAtomically(const fs::path& file, const std::function<void(const fs::path&)>& write)
+void writeAtomically(const fs::path& file, const std::function<void(const fs::path&)>& write,
+                     const std::function<void()>& beforeRename)
 {
     const fs::path tmp = temporaryBeside(file);
     std::error_code ignored;
@@ -58,6 +85,16 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
         throw refuse(std::strerror(why));
     }
     ::close(fd);
+    if (beforeRename) {
+        try {
+            beforeRename();
+        } catch (const std::bad_alloc&) {
+            fs::remove(tmp, ignored);
+            throw;
+        } catch (const std::exception& e) {
+            throw refuse(e.what());
+        }
+    }
     std::error_code error;
     fs::rename(tmp, file, error);
     if (error) throw refuse(error.message());

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <openvdb/io/Stream.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <iterator>
 #include <fstream>
@@ -191,6 +192,12 @@ TEST(TreeGridsIo, VdbRenderDrawsTheDensity)
     EXPECT_LT(lit, 64 * 64 / 2);
 }
 
+std::string readBytes(const fs::path& p)
+{
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 /// Writes grids to a fresh file and returns its path.
 fs::path written(const test::TempDir& dir)
 {
@@ -364,6 +371,38 @@ TEST(TreeGridsIo, RewritingReplacesTheFileAndItsManifest)
     EXPECT_EQ(r.densityPyramid.size(), 1u);
     EXPECT_EQ(r.density->activeVoxelCount(), finer.density->activeVoxelCount());
     EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 2);
+}
+
+TEST(TreeGridsIo, AFailedManifestLeavesThePreviousPairAndAKilledBakesTemporariesGo)
+{
+    const test::TempDir dir;
+    const fs::path file = dir.path() / "tree.vdb";
+    writeTreeGrids(twoBoughs(0.8, 1), file, kProvenance);
+    const std::string before = readBytes(file), manifest = readBytes(file.string() + ".json");
+    // What a bake killed mid-write leaves: temporaries of the grid and of the manifest.
+    for (const char* stale :
+         {".tree.vdb.tmp-0123456789abcdef", ".tree.vdb.json.tmp-fedcba9876543210"}) {
+        std::ofstream(dir.path() / stale) << "half";
+    }
+    // The manifest cannot be put in place (its name is made a folder): the new grid must not
+    // replace the old one.
+    fs::remove(file.string() + ".json");
+    fs::create_directory(file.string() + ".json");
+    EXPECT_THROW(writeTreeGrids(twoBoughs(0.5, 2), file, kProvenance), BakeError);
+    EXPECT_EQ(readBytes(file), before);
+    fs::remove(file.string() + ".json");
+    std::ofstream(file.string() + ".json", std::ios::binary) << manifest;
+    EXPECT_EQ(readTreeGrids(file).voxelSize_cm, 0.8);
+    // The stale temporaries were removed by that write; nothing of its own is left.
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir.path())) {
+        names.push_back(e.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"tree.vdb", "tree.vdb.json"}));
+    // And the next bake replaces both.
+    writeTreeGrids(twoBoughs(0.5, 2), file, kProvenance);
+    EXPECT_EQ(readTreeGrids(file).voxelSize_cm, 0.5);
 }
 
 }  // namespace

@@ -134,5 +134,32 @@ TEST(AtomicFile, OutputsApartFromInputsAndFromEachOther)
     EXPECT_EQ(readFile(scene), "{}");
 }
 
+TEST(AtomicFile, WhatMustComeFirstRunsBeforeTheRenameAndCanStopIt)
+{
+    const test::TempDir dir;
+    const fs::path file = dir.write("grid.vdb", "old");
+    bool ran = false;
+    writeAtomically(
+        file, [](const fs::path& tmp) { std::ofstream(tmp) << "new"; },
+        [&] {
+            ran = true;
+            EXPECT_EQ(readFile(file), "old");  // not renamed yet
+        });
+    EXPECT_TRUE(ran);
+    EXPECT_EQ(readFile(file), "new");
+    EXPECT_THROW(writeAtomically(
+                     file, [](const fs::path& tmp) { std::ofstream(tmp) << "newer"; },
+                     [] { throw std::runtime_error("manifest: disk full"); }),
+                 InputError);
+    EXPECT_EQ(readFile(file), "new");
+    EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"grid.vdb"});
+    // A killed write's temporary, and a file that only looks like one, beside it.
+    std::ofstream(dir.path() / ".grid.vdb.tmp-0123456789abcdef") << "half";
+    std::ofstream(dir.path() / ".grid.vdb.tmp-mine") << "keep";
+    EXPECT_EQ(removeStaleTemporaries(file), 1);
+    EXPECT_EQ(listing(dir.path()),
+              (std::vector<std::string>{".grid.vdb.tmp-mine", "grid.vdb"}));
+}
+
 }  // namespace
 }  // namespace pine::io

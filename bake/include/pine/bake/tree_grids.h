@@ -112,10 +112,12 @@ struct BakeProvenance {
     unsigned seed = 0;
 };
 
-/// Writes the grids atomically (temporary file in the same folder, then rename) with file
-/// metadata (format version, units, extinction law and its formula, voxel size, scene, tree,
-/// seed, tool version) and a manifest `PATH.json` beside it recording the file's size and
-/// checksum. Throws BakeError.
+/// Writes the grids atomically (temporary file in the same folder, synced, then renamed) with
+/// file metadata (format version, units, extinction law and its formula, voxel size, scene,
+/// tree, seed, tool version) and a manifest `PATH.json` beside it recording the file's size
+/// and checksum, put in place before the grid: if anything fails the previous pair stays, and
+/// a kill between the two leaves a grid its manifest refuses. Removes the temporaries of a
+/// killed earlier write first. Throws BakeError.
 void writeTreeGrids(const TreeGrids& grids, const std::filesystem::path& path,
                     const BakeProvenance& provenance);
 

@@ -16,13 +16,20 @@ namespace pine::io {
 /// shortened in the temporary's, never refused for it.
 std::filesystem::path temporaryBeside(const std::filesystem::path& file);
 
-/// Writes `file` by calling write(temporary) on a temporary beside it, then renaming the
-/// temporary onto `file`. If write throws or the rename fails, the temporary is removed and
-/// `file` is left as it was; throws InputError "cannot write 'FILE': WHY" (WHY from what the
-/// callback threw), except for std::bad_alloc and non-standard exceptions, rethrown as they
-/// are.
+/// Writes `file` by calling write(temporary) on a temporary beside it, syncing it to the disk,
+/// calling beforeRename() if given (what must be in place before `file` is: a manifest), then
+/// renaming the temporary onto `file`. If write or beforeRename throws or the rename fails,
+/// the temporary is removed and `file` is left as it was; throws InputError "cannot write
+/// 'FILE': WHY" (WHY from what the callback threw), except for std::bad_alloc and non-standard
+/// exceptions, rethrown as they are.
 void writeAtomically(const std::filesystem::path& file,
-                     const std::function<void(const std::filesystem::path& temporary)>& write);
+                     const std::function<void(const std::filesystem::path& temporary)>& write,
+                     const std::function<void()>& beforeRename = {});
+
+/// Removes the temporaries that writes of `file` left behind when killed (temporaryBeside's
+/// names); returns how many. A write of the same file running now loses its temporary and
+/// fails cleanly.
+int removeStaleTemporaries(const std::filesystem::path& file);
 
 /// writeAtomically of `text`, checking that every byte reached the disk.
 void writeTextAtomically(const std::filesystem::path& file, const std::string& text);
