@@ -6,14 +6,18 @@
 
 #include "pine/support/atomic_file.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <string_view>
 #include <system_error>
+#include <vector>
 
 namespace pine::vdbtrace {
 namespace {
@@ -96,8 +100,28 @@ void writeAtomically(const char* what, const char* format, const fs::path& path,
     // still write OpenEXR.
     auto out = OIIO::ImageOutput::create(format);
     if (!out) fail(what, path, OIIO::geterror());
+    // libpng does not say when the disk is full (a truncated PNG, status 0, was seen): a
+    // format that can is written to memory first and its bytes written here, each checked.
+    const bool viaMemory = std::string_view(format) == "png" && out->supports("ioproxy");
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput memory(bytes);
+    if (viaMemory && !out->set_ioproxy(&memory)) fail(what, path, out->geterror());
     try {
         io::writeAtomically(path, [&](const fs::path& temporary) {
+            if (viaMemory) {
+                if (!out->open(temporary.string(), spec) ||
+                    !out->write_image(spec.format, pixels) || !out->close()) {
+                    throw std::runtime_error(oneLine(out->geterror()));
+                }
+                std::FILE* f = std::fopen(temporary.c_str(), "wb");
+                if (!f) throw std::runtime_error(std::strerror(errno));
+                const bool written = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+                const int why = errno;
+                if (std::fclose(f) != 0 || !written) {
+                    throw std::runtime_error(std::strerror(written ? errno : why));
+                }
+                return;
+            }
             if (!out->open(temporary.string(), spec)) {
                 throw std::runtime_error(oneLine(out->geterror()));
             }
