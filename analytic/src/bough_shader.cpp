@@ -173,6 +173,12 @@ BoughExact boughExact(const BoughGeometry& bough, const BoughView& view, bool sh
     };
     out.alpha = {overChords(true, false), overChords(true, true)};
     out.transfer = {overChords(false, false), overChords(false, true)};
+    // The rule integrates an opaque strip to 1 within rounding (1 + 2^-52 was seen): kept in
+    // the physical bounds, each half's transfer within its opacity.
+    out.alpha.front = std::clamp(out.alpha.front, 0.0, 1.0);
+    out.alpha.rear = std::clamp(out.alpha.rear, 0.0, 1.0 - out.alpha.front);
+    out.transfer.front = std::clamp(out.transfer.front, 0.0, out.alpha.front);
+    out.transfer.rear = std::clamp(out.transfer.rear, 0.0, out.alpha.rear);
     return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -23,6 +24,15 @@ std::optional<Vec3> safeNormalize(const Vec3& v)
         return std::nullopt;
     }
     return v / len;
+}
+
+std::optional<Vec3> normalizeGiven(const Vec3& v)
+{
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return std::nullopt;
+    const double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    if (!(largest > 0.0)) return std::nullopt;
+    const Vec3 scaled = v / largest;  // its largest component is +-1: no under- or overflow
+    return scaled / glm::length(scaled);
 }
 
 double angleBetween(const Vec3& a, const Vec3& b)

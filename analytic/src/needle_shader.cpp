@@ -27,7 +27,9 @@ double needleSpecular(const Vec3& axis, const Vec3& L, const Vec3& V, double exp
     if (shsv <= 0.0) return 0.0;
     // cos(alpha_H - alpha_V) = H_p . V_p / (s_h s_v), clamped (see header).
     const double cosHV = std::clamp(glm::dot(h.perp, v.perp) / shsv, 0.0, 1.0);
-    return 0.5 * std::pow(h.s, exponent) * cosHV * std::sqrt(2.0 * kPi / exponent);
+    // The lobe's integral, sqrt(2 pi / n) by Laplace, never above pi's (see header).
+    const double lobe = exponent >= 2.0 / kPi ? std::sqrt(2.0 * kPi / exponent) : kPi;
+    return 0.5 * std::pow(h.s, exponent) * cosHV * lobe;
 }
 
 double needleProjectedArea(const Vec3& axis, const Vec3& V, double radius_cm, double length_cm)

@@ -59,7 +59,7 @@ public:
             d[i] = v[i].get<double>();
             if (!std::isfinite(d[i])) throw CaseError(key, "must be finite");
         }
-        const auto unit = safeNormalize(d);
+        const auto unit = normalizeGiven(d);
         if (!unit) throw CaseError(key, "must not be a zero vector");
         return *unit;
     }
@@ -220,6 +220,14 @@ json evaluateCase(const json& input)
         throw CaseError("level", "must be \"needle\", \"cone\" or \"bough\"");
     }
     r.rejectUnread();
+    // Valid but enormous inputs (a radius of 1e308) can overflow a result: refused, never a
+    // NaN or an infinity written as null (the layer rates' "inf" is a string, not checked).
+    for (const auto& [key, value] : out.items()) {
+        if (value.is_number() && !std::isfinite(value.get<double>())) {
+            throw CaseError("", "output '" + key + "' overflows double precision: the inputs " +
+                                    "are too large or too small for it");
+        }
+    }
     out["level"] = level;
     return out;
 }

@@ -1,5 +1,7 @@
 #include "json_reader.h"
 
+#include "pine/analytic/direction.h"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -124,13 +126,10 @@ Vec3 readVec3(const Json& v, const Where& where) { return readVector<3>(v, where
 
 Vec3 readDirection(const Json& v, const Where& where)
 {
-    const Vec3 d = readVec3(v, where);
-    // Scaled by its largest component first, so that neither 1e-200 nor 1e200 under- or
-    // overflows the length: only a true zero vector has no direction.
-    const double largest = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
-    if (!(largest > 0.0)) where.fail("must not be a zero vector");
-    const Vec3 scaled = d / largest;
-    return scaled / glm::length(scaled);
+    // Only a true zero vector has no direction: 1e-200 and 1e200 are directions.
+    const auto unit = analytic::normalizeGiven(readVec3(v, where));
+    if (!unit) where.fail("must not be a zero vector");
+    return *unit;
 }
 
 Vec3 readColour(const Json& v, const Where& where, const Range& range)

@@ -140,6 +140,30 @@ TEST(BoughShader, ExactModelWithoutShadowsReflectsItsOpacity)
     }
 }
 
+TEST(BoughShader, ExactModelStaysWithinItsBoundsWhenOpaque)
+{
+    // An opaque bough (A = 1, or tiny spacing) integrates to 1 within rounding; the opacity
+    // must not pass 1 (1 + 2^-52 was seen through analytic eval), nor a transfer its opacity.
+    test::RandomDirections rnd(41);
+    for (int i = 0; i < 300; ++i) {
+        BoughGeometry b = randomBough(rnd);
+        if (i % 2 == 0) b.cone.needlesPerCone = 1e6;  // A = 1
+        else b.coneSpacing_cm = 1e-4;
+        const BoughView view = boughView(b.cone.aperture_rad, rnd.direction(), rnd.direction(),
+                                         rnd.direction());
+        for (const bool shadows : {false, true}) {
+            const BoughExact e = boughExact(b, view, shadows);
+            EXPECT_GE(e.alpha.front, 0.0);
+            EXPECT_GE(e.alpha.rear, 0.0);
+            EXPECT_LE(e.total(), 1.0);
+            EXPECT_LE(e.transfer.front, e.alpha.front);
+            EXPECT_LE(e.transfer.rear, e.alpha.rear);
+            EXPECT_GE(e.transfer.front, 0.0);
+            EXPECT_GE(e.transfer.rear, 0.0);
+        }
+    }
+}
+
 TEST(BoughShader, LinearLawMatchesExactWhenThinAtFirstOrder)
 {
     // The linear law 1 - n A is the first-order expansion of T^n = exp(-n mu),

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace pine::analytic {
@@ -63,6 +64,35 @@ TEST(NeedleShader, SpecularMatchesQuadratureToOrderOneOverN)
             if (cosHV > 3.0 / std::sqrt(n)) {
                 EXPECT_LE(std::abs(ours - ref), ref / n) << "n=" << n << " cos=" << cosHV;
             }
+        }
+    }
+}
+
+TEST(NeedleShader, SpecularStaysBoundedAsTheExponentVanishes)
+{
+    // sqrt(2 pi / n) diverges as n -> 0 (an exponent of 5e-324 gave NaN) where the lobe's
+    // integral over the half-circle tends to pi: capped there, so R_s <= pi / 2 for every
+    // n > 0, continuous at n = 2 / pi and the printed form above it.
+    test::RandomDirections rnd(29);
+    for (int i = 0; i < 500; ++i) {
+        const Vec3 axis = rnd.direction(), L = rnd.direction(), V = rnd.direction();
+        for (const double n : {5e-324, 1e-300, 1e-10, 0.01, 0.5}) {
+            const double r = needleSpecular(axis, L, V, n);
+            ASSERT_TRUE(std::isfinite(r)) << "n=" << n;
+            EXPECT_GE(r, 0.0);
+            EXPECT_LE(r, 0.5 * kPi);
+        }
+        const double at = 2.0 / kPi;
+        EXPECT_NEAR(needleSpecular(axis, L, V, at), needleSpecular(axis, L, V, at * (1 - 1e-9)),
+                    1e-8);
+        const auto H = safeNormalize(L + V);
+        if (!H) continue;
+        const AxisProjection h = projectOnAxis(axis, *H), v = projectOnAxis(axis, V);
+        if (!(h.s * v.s > 0.0)) continue;
+        const double cosHV = std::clamp(glm::dot(h.perp, v.perp) / (h.s * v.s), 0.0, 1.0);
+        for (const double n : {0.7, 5.0, 100.0}) {
+            EXPECT_EQ(needleSpecular(axis, L, V, n),
+                      0.5 * std::pow(h.s, n) * cosHV * std::sqrt(2.0 * kPi / n));
         }
     }
 }

@@ -25,6 +25,12 @@ AxisProjection projectOnAxis(const Vec3& axis, const Vec3& dir);
 /// The unit vector along v, or nothing when v has no usable length (zero, denormal, NaN, inf).
 std::optional<Vec3> safeNormalize(const Vec3& v);
 
+/// The unit vector along a direction a user gave, whatever its finite magnitude: scaled by its
+/// largest component first, so that neither 1e-200 nor 1e200 under- or overflows its length.
+/// Nothing for the zero vector or a non-finite component. (safeNormalize, for vectors computed
+/// from others, keeps refusing what is near zero: there it means parallel.)
+std::optional<Vec3> normalizeGiven(const Vec3& v);
+
 /// Angle in [0, pi] between two vectors, by atan2: exact near 0 and pi where acos is not,
 /// and 0 (not NaN) when either vector is zero.
 double angleBetween(const Vec3& a, const Vec3& b);

@@ -27,7 +27,10 @@ double needleDiffuse(const Vec3& axis, const Vec3& L, const Vec3& V);
 ///   R_s = 1/2 s_h^n max(0, cos(alpha_H - alpha_V)) sqrt(2 pi / n).
 /// The max(0, .) is our correction: printed without it, eq. (2) goes negative when H_p leans
 /// more than 90 degrees from V_p. Relative error O(1/n) while the lobe lies inside the visible
-/// half of the cylinder; valid for n >~ 20. Zero when L = -V (no half vector).
+/// half of the cylinder; valid for n >~ 20. Zero when L = -V (no half vector). Below
+/// n = 2 / pi, where sqrt(2 pi / n) would exceed pi, the integral of cos^n over the half-circle
+/// (at most pi, the integral of 1), the factor is pi: bounded as n -> 0, where the printed
+/// form diverges (an exponent of 5e-324 gave NaN); unchanged for every n >= 2 / pi.
 /// @param exponent  n > 0
 double needleSpecular(const Vec3& axis, const Vec3& L, const Vec3& V, double exponent);
 
