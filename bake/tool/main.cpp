@@ -1,5 +1,6 @@
 // bake: voxelize a scene's trees into OpenVDB grids (one .vdb and its manifest per tree).
 #include "pine/bake/extinction_law.h"
+#include "pine/bake/resource_estimate.h"
 #include "pine/bake/tree_boughs.h"
 #include "pine/bake/tree_grids.h"
 #include "pine/scenes/scene.h"
@@ -63,8 +64,14 @@ bake::BakeSettings forScene(bake::BakeSettings settings, const std::string& law,
     return settings;
 }
 
+/// --max-memory in GiB, 0 for the default, as bytes.
+double memoryLimit(double gib)
+{
+    return gib > 0.0 ? gib * 1024.0 * 1024.0 * 1024.0 : bake::defaultMemoryLimit();
+}
+
 int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& common,
-            const std::string& law, const fs::path& out)
+            const std::string& law, const fs::path& out, double maxMemoryGiB)
 {
     const auto start = std::chrono::steady_clock::now();
     io::checkWritable(out);  // before the work, not after it
@@ -76,6 +83,8 @@ int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& commo
                   << scene.trees.size() << ")\n";
         return 2;
     }
+    bake::checkMemory(bake::estimateBake(scene, {std::size_t(tree)}, settings.voxelSize_cm),
+                      memoryLimit(maxMemoryGiB), sceneFile.string());
     Totals totals;
     bakeTree(scene, sceneFile, std::size_t(tree), settings, out, totals);
     summarize(totals, start);
@@ -90,13 +99,19 @@ fs::path treeFile(const fs::path& dir, std::size_t index)
 }
 
 int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const std::string& law,
-              const fs::path& dir)
+              const fs::path& dir, double maxMemoryGiB)
 {
     const auto start = std::chrono::steady_clock::now();
     io::checkWritable(treeFile(dir, 0));
     const scenes::Scene scene = scenes::loadScene(sceneFile);
     const bake::BakeSettings settings = forScene(common, law, scene);
     const std::size_t n = scene.trees.size();
+    std::vector<std::size_t> all(n);
+    for (std::size_t i = 0; i < n; ++i) all[i] = i;
+    bake::checkMemory(
+        bake::estimateBake(scene, all, settings.voxelSize_cm,
+                           std::size_t(tbb::this_task_arena::max_concurrency())),
+        memoryLimit(maxMemoryGiB), sceneFile.string());
     for (std::size_t i = 0; i < n; ++i) {  // the names differ; the scene may be among them
         io::checkOutputsApart({treeFile(dir, i), treeFile(dir, i).string() + ".json"}, {sceneFile});
     }
@@ -125,6 +140,7 @@ int main(int argc, char** argv)
 
     fs::path sceneFile, out, outDir;
     int tree = 0;
+    double maxMemoryGiB = 0.0;  // 0: bake::defaultMemoryLimit()
     bake::BakeSettings settings;
     std::string law;
     // CLI::PositiveNumber would print DBL_MAX in its message.
@@ -147,6 +163,11 @@ int main(int argc, char** argv)
                         "How the field stops light, written into the file (default: the "
                         "scene's render.extinction_law, fibre unless it says otherwise)")
             ->check(CLI::IsMember(bake::extinctionLawNames()));
+        cmd->add_option("--max-memory", maxMemoryGiB,
+                        "Refuse, before any work, a bake estimated to need more memory than "
+                        "this, in GiB (default: 80% of this machine's, " +
+                            bake::formatBytes(bake::defaultMemoryLimit()) + ")")
+            ->check(CLI::PositiveNumber);
         cmd->add_option("--levels", settings.pyramidLevels,
                         "Density levels at h, 2h, 4h, ... (1: no pyramid)")
             ->default_val(settings.pyramidLevels)
@@ -163,8 +184,8 @@ int main(int argc, char** argv)
 
     return tool::run("bake", app, argc, argv, [&] {
         try {
-            if (*treeCmd) return bakeOne(sceneFile, tree, settings, law, out);
-            return bakeScene(sceneFile, settings, law, outDir);
+            if (*treeCmd) return bakeOne(sceneFile, tree, settings, law, out, maxMemoryGiB);
+            return bakeScene(sceneFile, settings, law, outDir, maxMemoryGiB);
         } catch (...) {
             if (gProgressOpen.exchange(false)) std::fputc('\n', stderr);  // the error's own line
             throw;

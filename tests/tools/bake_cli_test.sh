@@ -23,6 +23,9 @@ expect_error "negative voxel size" 2 "voxel-size" -- scene "$bough" --voxel-size
 expect_error "bad levels" 2 "levels" -- tree "$bough" --tree 0 --voxel-size 1 --levels 0 --out "$work/a.vdb"
 expect_error "missing option" 2 "out" -- tree "$bough" --tree 0 --voxel-size 1
 expect_error "no subcommand" 2 "subcommand" --
+# Voxels too fine for the machine: refused before the bake.
+expect_error "fine voxels, one tree" 2 "voxels of 0.001 cm" -- tree "$src/scenes/three-firs.json" --tree 2 --voxel-size 1e-3 --out "$work/a.vdb"
+expect_error "fine voxels, all trees" 2 "more than --max-memory" -- scene "$bough" --voxel-size 0.05 --max-memory 0.01 --out-dir "$work"
 # A scene in the output folder under a tree file's name is not baked over.
 mkdir "$work/inplace"
 cp "$bough" "$work/inplace/tree_000.vdb"

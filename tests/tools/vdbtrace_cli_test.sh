@@ -39,6 +39,14 @@ tail -1 "$work/err" | grep -q "radiance overflowed" || fail "radiance overflow: 
 rm "$work/bright.json"
 [ -c /dev/null ] || fail "/dev/null is no longer a device"
 rm "$work/scene.json"
+# Resource bombs refused from the scene alone, before any tree is grown or pixel traced.
+sed 's/"resolution": \[640, 480\]/"resolution": [16384, 16384]/' "$src/scenes/bough.json" >"$work/huge.json"
+grep -q 16384 "$work/huge.json" || fail "huge.json: the resolution was not changed"
+expect_error "huge image" 2 "image 16384 x 16384 needs about" -- render "$work/huge.json" --out "$work/a.exr" --max-memory 8
+expect_error "tiny memory limit" 2 "more than --max-memory" -- render "$src/scenes/bough.json" --out "$work/a.exr" --max-memory 0.01
+expect_error "fine voxels" 2 "voxels of 0.0001 cm" -- render "$src/scenes/three-firs.json" --method reference --voxel-size 1e-4 --out "$work/a.exr"
+expect_error "many needles" 2 "needle cylinders" -- render "$src/scenes/paper-forest.json" --method geometry --out "$work/a.exr" --max-memory 0.3
+rm "$work/huge.json"
 [ -z "$(ls "$work" | grep -v -e '^out$' -e '^err$' -e '^broken.json$')" ] || fail "failed runs left files: $(ls "$work")"
 
 # An existing output survives a failed render.

@@ -1,5 +1,6 @@
 // vdbtrace: render a scene with the multiscale cone tracer, benchmark it, or compare methods.
 #include "pine/bake/extinction_law.h"
+#include "pine/bake/resource_estimate.h"
 #include "pine/bake/tree_boughs.h"
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
@@ -98,14 +99,25 @@ struct Loaded {
     vdbtrace::TracedScene traced;
 };
 
-std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model)
+/// The scene read, then `check`ed (what the work will need), then grown for the tracer.
+std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model,
+                             const std::function<void(const scenes::Scene&)>& check = {})
 {
     auto loaded = std::make_unique<Loaded>();
     loaded->scene = scenes::loadScene(file);
     model.apply(loaded->scene.render.model);
+    if (check) check(loaded->scene);
     loaded->traced = vdbtrace::buildTracedScene(loaded->scene);
     return loaded;
 }
+
+/// --max-memory in GiB, 0 for the default, as bytes.
+double memoryLimit(double gib)
+{
+    return gib > 0.0 ? gib * 1024.0 * 1024.0 * 1024.0 : bake::defaultMemoryLimit();
+}
+
+
 
 std::string describe(const scenes::Scene& scene, const vdbtrace::TracedScene& traced)
 {
@@ -129,7 +141,7 @@ fs::path besideWith(const fs::path& image, const std::string& suffix)
 int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs,
            vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles,
-           const ModelOverrides& model)
+           const ModelOverrides& model, double maxMemoryGiB)
 {
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
     // The extension decides the format: only EXR holds the render (its PNG goes beside it).
@@ -160,7 +172,13 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         std::cerr << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "
                   << baked->voxelSize_cm << " cm read\n";
     }
-    const auto loaded = load(sceneFile, model);
+    const auto loaded = load(sceneFile, model, [&](const scenes::Scene& scene) {
+        // Grids read from files are already in memory: only the image and trees remain.
+        bake::checkMemory(
+            bake::estimateRender(scene, baked ? "multiscale" : methodName,
+                                     settings.voxelSize_cm),
+            memoryLimit(maxMemoryGiB), sceneFile.string());
+    });
     std::cerr << "vdbtrace: " << sceneFile.string() << ": "
               << describe(loaded->scene, loaded->traced) << '\n';
     settings.geometry.built = [](const vdbtrace::GeometryBuild& b) {
@@ -361,6 +379,7 @@ int main(int argc, char** argv)
     app.require_subcommand(1);
 
     fs::path sceneFile, out, statsFile;
+    double maxMemoryGiB = 0.0;  // 0: bake::defaultMemoryLimit()
     std::string method = "multiscale";
     std::vector<std::string> aovs;
     auto* renderCmd = app.add_subcommand("render", "Render a scene to EXR (+ PNG preview)");
@@ -387,6 +406,12 @@ int main(int argc, char** argv)
     renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")
         ->required();
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
+    renderCmd
+        ->add_option("--max-memory", maxMemoryGiB,
+                     "Refuse, before any work, a render estimated to need more memory than "
+                     "this, in GiB (default: 80% of this machine's, " +
+                         bake::formatBytes(bake::defaultMemoryLimit()) + ")")
+        ->check(CLI::PositiveNumber);
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
         ->check(CLI::IsMember({"level"}));
     ModelOverrides model;
@@ -438,7 +463,8 @@ int main(int argc, char** argv)
 
     return tool::run("vdbtrace", app, argc, argv, [&] {
         if (*renderCmd) {
-            return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles, model);
+            return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles, model,
+                          maxMemoryGiB);
         }
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
         if (*compareCmd) {

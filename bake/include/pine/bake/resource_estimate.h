@@ -1,0 +1,54 @@
+// What a render or a bake will ask of the machine, estimated from the scene before any work
+// (a 16384 x 16384 image, a forest of 100,000 trees or a 1e-3 cm voxel would otherwise end in
+// std::bad_alloc after gigabytes): each species grown once and scaled by its placements.
+#pragma once
+
+#include "pine/scenes/scene.h"
+
+#include <string>
+#include <vector>
+
+namespace pine::bake {
+
+struct ResourceEstimate {
+    struct Part {
+        std::string what;  ///< "image 640 x 480", "2.45e+06 needle cylinders", ...
+        double bytes = 0.0;
+    };
+    std::vector<Part> parts;
+    double bytes() const;
+    /// The largest part the user can lower (the program itself only when nothing else is).
+    const Part& largest() const;
+};
+
+/// What the trees of `trees` (indices into scene.trees) hold, estimated by growing each
+/// species once (its first placement among them stands for the others).
+struct TreeTotals {
+    double branches = 0.0, boughs = 0.0, needles = 0.0;
+    double boughVolume_cm3 = 0.0;  ///< the cylinders the boughs' cones fill
+};
+TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size_t>& trees);
+
+/// The memory a render of `scene` by method `method` ("multiscale", "reference", "geometry")
+/// will need, within a factor of about two: the image and its outputs, the trees as the
+/// tracer holds them, and the method's own (explicit needles; voxels of `voxelSize_cm`). Each
+/// species is grown once, for its first placement, which stands for all of its placements.
+ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
+                                double voxelSize_cm);
+
+/// The memory a bake of `trees` (indices into scene.trees) at `voxelSize_cm` will need, with
+/// up to `concurrent` trees in memory at once (each written before the next).
+ResourceEstimate estimateBake(const scenes::Scene& scene, const std::vector<std::size_t>& trees,
+                              double voxelSize_cm, std::size_t concurrent = 1);
+
+/// 80% of the machine's physical memory, in bytes: --max-memory's default.
+double defaultMemoryLimit();
+
+/// "1.5 GiB", "12 MiB".
+std::string formatBytes(double bytes);
+
+/// Throws InputError naming the estimate's largest part when the whole exceeds `limitBytes`:
+/// "TASK: WHAT needs about X (Y in all), more than --max-memory Z allows (...)".
+void checkMemory(const ResourceEstimate& estimate, double limitBytes, const std::string& task);
+
+}  // namespace pine::bake

@@ -1,0 +1,201 @@
+#include "pine/bake/resource_estimate.h"
+
+#include "pine/bake/tree_boughs.h"
+#include "pine/scenes/tree.h"
+#include "pine/support/input_error.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+namespace pine::bake {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kGiB = 1024.0 * 1024.0 * 1024.0;
+
+// Bytes per item, from measured peaks (paper forest, README): an image pixel with its AOVs,
+// the EXR's interleaved copy and the previews; a branch or bough as the tracer holds it (its
+// profiles per light, its BVH node); a needle cylinder with Embree's BVH; a voxel of the six
+// grids and a light grid.
+constexpr double kBytesPerPixel = 96.0;
+constexpr double kBytesPerBranch = 200.0;
+constexpr double kBytesPerBough = 800.0, kBytesPerBoughLight = 1200.0;
+constexpr double kBytesPerNeedle = 220.0;
+constexpr double kBytesPerVoxel = 80.0;
+constexpr double kProgramBytes = 150.0 * 1024 * 1024;  // its libraries, before any scene
+constexpr const char* kProgram = "the program";
+
+using TreeSample = TreeTotals;  // of one grown tree per species
+
+TreeSample sampleTree(const scenes::Scene& scene, const scenes::TreePlacement& placement)
+{
+    const scenes::Tree tree = scenes::growTree(scene.species.at(placement.species), placement);
+    const scenes::TreeCounts counts = tree.counts();
+    TreeSample s;
+    s.branches = double(tree.segments.size());
+    s.boughs = double(counts.boughs);
+    s.needles = counts.needles;
+    for (const BoughSpec& b : treeBoughs(tree)) {
+        const analytic::ConeGeometry& c = b.needles.cone;
+        const double R = c.needleLength_cm * std::sin(c.aperture_rad);
+        const double length = std::sqrt((b.tip_cm.x - b.base_cm.x) * (b.tip_cm.x - b.base_cm.x) +
+                                        (b.tip_cm.y - b.base_cm.y) * (b.tip_cm.y - b.base_cm.y) +
+                                        (b.tip_cm.z - b.base_cm.z) * (b.tip_cm.z - b.base_cm.z));
+        s.boughVolume_cm3 +=
+            kPi * R * R * (length + c.needleLength_cm * std::cos(c.aperture_rad));
+    }
+    return s;
+}
+
+// One sample per species among the trees of `indices`: its first placement there.
+std::map<std::string, TreeSample> samples(const scenes::Scene& scene,
+                                          const std::vector<std::size_t>& indices)
+{
+    std::map<std::string, TreeSample> bySpecies;
+    for (const std::size_t i : indices) {
+        const scenes::TreePlacement& p = scene.trees.at(i);
+        if (!bySpecies.count(p.species)) bySpecies.emplace(p.species, sampleTree(scene, p));
+    }
+    return bySpecies;
+}
+
+// The trees of `indices`, each counted as its species' sample.
+TreeSample sumTrees(const scenes::Scene& scene, const std::vector<std::size_t>& indices)
+{
+    const std::map<std::string, TreeSample> bySpecies = samples(scene, indices);
+    TreeSample total;
+    for (const std::size_t i : indices) {
+        const TreeSample& one = bySpecies.at(scene.trees[i].species);
+        total.branches += one.branches;
+        total.boughs += one.boughs;
+        total.needles += one.needles;
+        total.boughVolume_cm3 += one.boughVolume_cm3;
+    }
+    return total;
+}
+
+std::string count(double n)
+{
+    char text[64];
+    std::snprintf(text, sizeof text, n < 1e6 ? "%.0f" : "%.3g", n);
+    return text;
+}
+
+std::vector<std::size_t> allTrees(const scenes::Scene& scene)
+{
+    std::vector<std::size_t> all(scene.trees.size());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+    return all;
+}
+
+void addVoxels(ResourceEstimate& e, const TreeSample& trees, double voxelSize_cm, double lights)
+{
+    if (!(voxelSize_cm > 0.0)) return;
+    const double voxels = trees.boughVolume_cm3 / (voxelSize_cm * voxelSize_cm * voxelSize_cm);
+    char size[32];
+    std::snprintf(size, sizeof size, "%.3g cm", voxelSize_cm);
+    e.parts.push_back({count(voxels) + " voxels of " + size,
+                       voxels * (kBytesPerVoxel + 4.0 * lights)});
+}
+
+}  // namespace
+
+TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size_t>& trees)
+{
+    return sumTrees(scene, trees);
+}
+
+double ResourceEstimate::bytes() const
+{
+    double sum = 0.0;
+    for (const Part& p : parts) sum += p.bytes;
+    return sum;
+}
+
+const ResourceEstimate::Part& ResourceEstimate::largest() const
+{
+    // The program itself is not something the user can lower: named only when alone.
+    static const Part none{"nothing", 0.0};
+    const Part* best = parts.empty() ? &none : &parts.front();
+    for (const Part& p : parts) {
+        const bool program = p.what == kProgram, bestProgram = best->what == kProgram;
+        if ((bestProgram && !program) || (program == bestProgram && p.bytes > best->bytes)) {
+            best = &p;
+        }
+    }
+    return *best;
+}
+
+ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
+                                double voxelSize_cm)
+{
+    ResourceEstimate e;
+    e.parts.push_back({kProgram, kProgramBytes});
+    const double pixels = double(scene.camera.width) * double(scene.camera.height);
+    e.parts.push_back({"image " + std::to_string(scene.camera.width) + " x " +
+                           std::to_string(scene.camera.height),
+                       pixels * kBytesPerPixel});
+    const TreeSample trees = sumTrees(scene, allTrees(scene));
+    const double lights = double(scene.pointLights.size() + scene.directionalLights.size());
+    e.parts.push_back({count(double(scene.trees.size())) + " trees (" + count(trees.boughs) +
+                           " boughs, " + count(trees.branches) + " branches)",
+                       trees.branches * kBytesPerBranch +
+                           trees.boughs * (kBytesPerBough + kBytesPerBoughLight * lights)});
+    if (method == "geometry") {
+        e.parts.push_back({count(trees.needles) + " needle cylinders",
+                           trees.needles * kBytesPerNeedle});
+    } else if (method == "reference") {
+        addVoxels(e, trees, voxelSize_cm, lights);
+    }
+    return e;
+}
+
+ResourceEstimate estimateBake(const scenes::Scene& scene, const std::vector<std::size_t>& trees,
+                              double voxelSize_cm, std::size_t concurrent)
+{
+    ResourceEstimate e;
+    e.parts.push_back({kProgram, kProgramBytes});
+    // The largest tree, as many times as trees are baked at once.
+    TreeSample largest;
+    for (const auto& [species, one] : samples(scene, trees)) {
+        if (one.boughVolume_cm3 > largest.boughVolume_cm3) largest = one;
+    }
+    const double copies = double(std::max<std::size_t>(1, std::min(concurrent, trees.size())));
+    largest.boughVolume_cm3 *= copies;
+    addVoxels(e, largest, voxelSize_cm, 0.0);
+    return e;
+}
+
+double defaultMemoryLimit()
+{
+    const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || size <= 0) return 16.0 * kGiB;
+    return 0.8 * double(pages) * double(size);
+}
+
+std::string formatBytes(double bytes)
+{
+    char text[32];
+    if (bytes >= kGiB) {
+        std::snprintf(text, sizeof text, "%.1f GiB", bytes / kGiB);
+    } else {
+        std::snprintf(text, sizeof text, "%.0f MiB", std::ceil(bytes / (1024.0 * 1024.0)));
+    }
+    return text;
+}
+
+void checkMemory(const ResourceEstimate& estimate, double limitBytes, const std::string& task)
+{
+    const double total = estimate.bytes();
+    if (!(total > limitBytes)) return;
+    throw InputError(task + ": " + estimate.largest().what + " needs about " +
+                     formatBytes(estimate.largest().bytes) + " (" + formatBytes(total) +
+                     " in all), more than --max-memory " + formatBytes(limitBytes) +
+                     " allows (lower it, or raise --max-memory)");
+}
+
+}  // namespace pine::bake

@@ -1,0 +1,42 @@
+// The resource estimate against the trees grown for real: growing one tree per species must
+// stand for the forest within the factor the refusals leave room for.
+#include "pine/bake/resource_estimate.h"
+#include "pine/scenes/tree.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace pine::bake {
+namespace {
+
+TEST(ResourceEstimate, OneTreePerSpeciesStandsForTheForest)
+{
+    // The paper forest: 80 firs of heights 100-114 cm from one species.
+    const scenes::Scene scene =
+        scenes::loadScene(std::string(PINE_SOURCE_DIR) + "/scenes/paper-forest.json");
+    std::vector<std::size_t> all;
+    double needles = 0.0, boughs = 0.0, branches = 0.0;
+    for (std::size_t i = 0; i < scene.trees.size(); ++i) {
+        all.push_back(i);
+        const scenes::Tree t = scenes::growTree(scene.species.at(scene.trees[i].species),
+                                                scene.trees[i]);
+        needles += t.counts().needles;
+        boughs += double(t.counts().boughs);
+        branches += double(t.segments.size());
+    }
+    const TreeTotals e = estimateTrees(scene, all);
+    EXPECT_NEAR(e.needles / needles, 1.0, 0.2);
+    EXPECT_NEAR(e.boughs / boughs, 1.0, 0.2);
+    EXPECT_NEAR(e.branches / branches, 1.0, 0.2);
+    // A render's parts: the image's and the method's, each named.
+    const ResourceEstimate geometry = estimateRender(scene, "geometry", 0.25);
+    EXPECT_NE(geometry.largest().what.find("needle cylinders"), std::string::npos);
+    const ResourceEstimate multiscale = estimateRender(scene, "multiscale", 0.25);
+    EXPECT_LT(multiscale.bytes(), geometry.bytes());
+    EXPECT_THROW(checkMemory(geometry, geometry.bytes() * 0.5, "x"), InputError);
+    EXPECT_NO_THROW(checkMemory(geometry, geometry.bytes() * 1.01, "x"));
+}
+
+}  // namespace
+}  // namespace pine::bake
