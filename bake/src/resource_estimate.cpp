@@ -177,6 +177,8 @@ double defaultMemoryLimit()
     return 0.8 * double(pages) * double(size);
 }
 
+double memoryLimit(double gib) { return gib > 0.0 ? gib * kGiB : defaultMemoryLimit(); }
+
 std::string formatBytes(double bytes)
 {
     char text[32];

@@ -64,12 +64,6 @@ bake::BakeSettings forScene(bake::BakeSettings settings, const std::string& law,
     return settings;
 }
 
-/// --max-memory in GiB, 0 for the default, as bytes.
-double memoryLimit(double gib)
-{
-    return gib > 0.0 ? gib * 1024.0 * 1024.0 * 1024.0 : bake::defaultMemoryLimit();
-}
-
 int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& common,
             const std::string& law, const fs::path& out, double maxMemoryGiB)
 {
@@ -84,7 +78,7 @@ int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& commo
         return 2;
     }
     bake::checkMemory(bake::estimateBake(scene, {std::size_t(tree)}, settings.voxelSize_cm),
-                      memoryLimit(maxMemoryGiB), sceneFile.string());
+                      bake::memoryLimit(maxMemoryGiB), sceneFile.string());
     Totals totals;
     bakeTree(scene, sceneFile, std::size_t(tree), settings, out, totals);
     summarize(totals, start);
@@ -111,7 +105,7 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
     bake::checkMemory(
         bake::estimateBake(scene, all, settings.voxelSize_cm,
                            std::size_t(tbb::this_task_arena::max_concurrency())),
-        memoryLimit(maxMemoryGiB), sceneFile.string());
+        bake::memoryLimit(maxMemoryGiB), sceneFile.string());
     for (std::size_t i = 0; i < n; ++i) {  // the names differ; the scene may be among them
         io::checkOutputsApart({treeFile(dir, i), treeFile(dir, i).string() + ".json"}, {sceneFile});
     }
@@ -143,17 +137,7 @@ int main(int argc, char** argv)
     double maxMemoryGiB = 0.0;  // 0: bake::defaultMemoryLimit()
     bake::BakeSettings settings;
     std::string law;
-    // CLI::PositiveNumber would print DBL_MAX in its message.
-    const CLI::Validator positive(
-        [](std::string& text) -> std::string {
-            try {
-                const double v = std::stod(text);
-                if (std::isfinite(v) && v > 0.0) return {};
-            } catch (const std::exception&) {
-            }
-            return "must be a number > 0, got '" + text + "'";
-        },
-        "> 0");
+    const CLI::Validator positive = tool::positiveNumber();
     const auto addCommon = [&](CLI::App* cmd) {
         cmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
         cmd->add_option("--voxel-size", settings.voxelSize_cm, "Voxel size in cm")
@@ -167,7 +151,7 @@ int main(int argc, char** argv)
                         "Refuse, before any work, a bake estimated to need more memory than "
                         "this, in GiB (default: 80% of this machine's, " +
                             bake::formatBytes(bake::defaultMemoryLimit()) + ")")
-            ->check(CLI::PositiveNumber);
+            ->check(positive);
         cmd->add_option("--levels", settings.pyramidLevels,
                         "Density levels at h, 2h, 4h, ... (1: no pyramid)")
             ->default_val(settings.pyramidLevels)

@@ -38,8 +38,9 @@ int removeStaleTemporaries(const fs::path& file)
     int removed = 0;
     for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
         const std::string name = it->path().filename().string();
+        std::error_code kind;
         if (name.size() == prefix.size() + 16 && name.compare(0, prefix.size(), prefix) == 0 &&
-            it->is_regular_file(error)) {
+            it->is_regular_file(kind)) {
             std::error_code ignored;
             if (fs::remove(it->path(), ignored)) ++removed;
         }
@@ -93,6 +94,9 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
             throw;
         } catch (const std::exception& e) {
             throw refuse(e.what());
+        } catch (...) {
+            fs::remove(tmp, ignored);
+            throw;
         }
     }
     std::error_code error;
@@ -146,14 +150,21 @@ void checkWritable(const fs::path& file)
 
 bool sameFile(const fs::path& a, const fs::path& b)
 {
-    std::error_code error;
-    if (fs::exists(a, error) && fs::exists(b, error)) {
+    std::error_code ea, eb;
+    if (fs::exists(a, ea) && fs::exists(b, eb)) {
+        std::error_code error;
         const bool same = fs::equivalent(a, b, error);
         if (!error) return same;
     }
-    const fs::path ca = fs::weakly_canonical(fs::absolute(a, error), error);
-    const fs::path cb = fs::weakly_canonical(fs::absolute(b, error), error);
-    return ca == cb;
+    // Resolved where the folders allow it, else lexically: a failure is never "the same".
+    const auto resolved = [](const fs::path& p) {
+        std::error_code error;
+        const fs::path absolute = fs::absolute(p, error);
+        if (error) return p.lexically_normal();
+        const fs::path canonical = fs::weakly_canonical(absolute, error);
+        return error ? absolute.lexically_normal() : canonical;
+    };
+    return resolved(a) == resolved(b);
 }
 
 void checkOutputsApart(const std::vector<fs::path>& outputs, const std::vector<fs::path>& inputs)

@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 
+#include <cmath>
 #include <iostream>
 #include <new>
 #include <string>
@@ -57,6 +58,20 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
         std::cerr << name << ": " << oneLine(e.what()) << '\n';
         return 1;
     }
+}
+
+CLI::Validator positiveNumber()
+{
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            try {
+                const double v = std::stod(text);
+                if (std::isfinite(v) && v > 0.0) return {};
+            } catch (const std::exception&) {
+            }
+            return "must be a number > 0, got '" + text + "'";
+        },
+        "> 0");
 }
 
 double peakMemoryMiB()

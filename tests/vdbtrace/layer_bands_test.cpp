@@ -78,6 +78,18 @@ TEST(LayerBands, ABandEndsWhereTheLineTurnsBackOrLeavesTheMedium)
         EXPECT_EQ(bands.span(0.5, 0.0), 0.0);
     }
     {
+        // A grazing span inside a band running either way stays in that band.
+        for (const double sign : {1.0, -1.0}) {
+            LayerBands bands;
+            const double T = bands.span(0.2, 0.5 * sign) * bands.span(0.2, 0.0) *
+                             bands.span(0.2, 0.5 * sign);
+            EXPECT_NEAR(T, 1.0 - 0.6, 1e-12) << sign;
+        }
+        // A span barely crossing the layers meets its needles, not infinitely many.
+        LayerBands bands;
+        EXPECT_NEAR(bands.span(0.01, 1e-320), 0.99, 1e-12);  // 0.01 / 1e-320 overflows
+    }
+    {
         // More needles than one band can hold: opaque, never negative or NaN.
         LayerBands bands;
         EXPECT_EQ(bands.span(3.0, 0.2), 0.0);

@@ -96,22 +96,27 @@ bool isStandardAttribute(std::string_view key)
 void writeAtomically(const char* what, const char* format, const fs::path& path,
                      const OIIO::ImageSpec& spec, const void* pixels)
 {
+    // libpng does not say when the disk is full (a truncated PNG, status 0, was seen): a
+    // format that can is written to memory first and its bytes written here, each checked.
+    // The memory outlives `out`, whose destructor may still close into it.
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput memory(bytes);
     // Choose the plugin by name, not by the temporary's extension: writeExr("x.img") must
     // still write OpenEXR.
     auto out = OIIO::ImageOutput::create(format);
     if (!out) fail(what, path, OIIO::geterror());
-    // libpng does not say when the disk is full (a truncated PNG, status 0, was seen): a
-    // format that can is written to memory first and its bytes written here, each checked.
     const bool viaMemory = std::string_view(format) == "png" && out->supports("ioproxy");
-    std::vector<unsigned char> bytes;
-    OIIO::Filesystem::IOVecOutput memory(bytes);
     if (viaMemory && !out->set_ioproxy(&memory)) fail(what, path, out->geterror());
     try {
         io::writeAtomically(path, [&](const fs::path& temporary) {
             if (viaMemory) {
-                if (!out->open(temporary.string(), spec) ||
-                    !out->write_image(spec.format, pixels) || !out->close()) {
+                if (!out->open(temporary.string(), spec)) {
                     throw std::runtime_error(oneLine(out->geterror()));
+                }
+                if (!out->write_image(spec.format, pixels) || !out->close()) {
+                    const std::string why = oneLine(out->geterror());
+                    out->close();
+                    throw std::runtime_error(why);
                 }
                 std::FILE* f = std::fopen(temporary.c_str(), "wb");
                 if (!f) throw std::runtime_error(std::strerror(errno));

@@ -101,6 +101,7 @@ public:
     double transmittance(const FieldReader::Rates& r, double ta, double tb)
     {
         if (!mBanded) return std::exp(-r.sigma * (tb - ta));
+        if (!(tb > ta)) return 1.0;  // an empty span (a surface on a voxel's face) is no gap
         if (ta > mEnd) mBands.span(0.0, 0.0);  // out of the medium and in again: a new band
         mEnd = tb;
         return mBands.span(r.sigma * (tb - ta), r.layers * (tb - ta));

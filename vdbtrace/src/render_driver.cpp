@@ -138,7 +138,7 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
     if (bad > 0) {
         throw InputError("radiance overflowed: " + std::to_string(bad) +
                          " pixel values are not finite (a light too bright or too near a "
-                         "surface for float radiance)");
+                         "surface for float radiance, or a NaN from the shading)");
     }
     return result;
 }

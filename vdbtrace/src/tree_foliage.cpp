@@ -30,6 +30,10 @@ std::vector<int> treeRegions(const Image& segmentation)
     // that reaches it first.
     std::deque<std::size_t> queue;
     for (std::size_t i = 0; i < tree.size(); ++i) {
+        if (!(tree[i] < 16777216.0f)) {  // NaN or beyond float's exact integers: not an index
+            throw ImageError("the \"tree\" AOV holds " + std::to_string(tree[i]) +
+                             ", not a tree index");
+        }
         if (tree[i] >= 0.0f) {
             region[i] = int(std::lround(tree[i]));
             queue.push_back(i);
@@ -88,7 +92,7 @@ std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double 
     const std::vector<TreeFoliage> b = foliageByTree(truth, regions);
     std::vector<TreeBias> out;
     for (std::size_t k = 0; k < b.size(); ++k) {  // the same regions, so the same trees
-        if (!(b[k].coverage >= minCoverage)) continue;
+        if (!(b[k].coverage >= minCoverage) || !(b[k].coverage > 0.0)) continue;
         TreeBias t{a[k], b[k], a[k].coverage / b[k].coverage - 1.0,
                    b[k].luminance > 0.0 ? a[k].luminance / b[k].luminance - 1.0 : 0.0};
         out.push_back(t);

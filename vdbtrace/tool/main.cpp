@@ -111,14 +111,6 @@ std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model,
     return loaded;
 }
 
-/// --max-memory in GiB, 0 for the default, as bytes.
-double memoryLimit(double gib)
-{
-    return gib > 0.0 ? gib * 1024.0 * 1024.0 * 1024.0 : bake::defaultMemoryLimit();
-}
-
-
-
 std::string describe(const scenes::Scene& scene, const vdbtrace::TracedScene& traced)
 {
     double needles = 0.0, branches = 0.0;
@@ -173,11 +165,16 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                   << baked->voxelSize_cm << " cm read\n";
     }
     const auto loaded = load(sceneFile, model, [&](const scenes::Scene& scene) {
-        // Grids read from files are already in memory: only the image and trees remain.
-        bake::checkMemory(
-            bake::estimateRender(scene, baked ? "multiscale" : methodName,
-                                     settings.voxelSize_cm),
-            memoryLimit(maxMemoryGiB), sceneFile.string());
+        // Grids read from files are already in memory: the image, the trees and the light
+        // reaching each of their voxels remain.
+        bake::ResourceEstimate need =
+            bake::estimateRender(scene, baked ? "multiscale" : methodName, settings.voxelSize_cm);
+        if (baked) {
+            const double lights = double(scene.pointLights.size() + scene.directionalLights.size());
+            need.parts.push_back(
+                {"light grids", double(baked->layerOpacity->activeVoxelCount()) * 8.0 * lights});
+        }
+        bake::checkMemory(need, bake::memoryLimit(maxMemoryGiB), sceneFile.string());
     });
     std::cerr << "vdbtrace: " << sceneFile.string() << ": "
               << describe(loaded->scene, loaded->traced) << '\n';
@@ -411,7 +408,7 @@ int main(int argc, char** argv)
                      "Refuse, before any work, a render estimated to need more memory than "
                      "this, in GiB (default: 80% of this machine's, " +
                          bake::formatBytes(bake::defaultMemoryLimit()) + ")")
-        ->check(CLI::PositiveNumber);
+        ->check(tool::positiveNumber());
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
         ->check(CLI::IsMember({"level"}));
     ModelOverrides model;

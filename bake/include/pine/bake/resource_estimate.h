@@ -30,7 +30,7 @@ struct TreeTotals {
 TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size_t>& trees);
 
 /// The memory a render of `scene` by method `method` ("multiscale", "reference", "geometry")
-/// will need, within a factor of about two: the image and its outputs, the trees as the
+/// will need, within a factor of about 1.5 of the peaks measured (docs/vdbtrace.md): the image and its outputs, the trees as the
 /// tracer holds them, and the method's own (explicit needles; voxels of `voxelSize_cm`). Each
 /// species is grown once, for its first placement, which stands for all of its placements.
 ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
@@ -43,6 +43,8 @@ ResourceEstimate estimateBake(const scenes::Scene& scene, const std::vector<std:
 
 /// 80% of the machine's physical memory, in bytes: --max-memory's default.
 double defaultMemoryLimit();
+/// --max-memory in GiB as bytes; 0 for defaultMemoryLimit().
+double memoryLimit(double gib);
 
 /// "1.5 GiB", "12 MiB".
 std::string formatBytes(double bytes);

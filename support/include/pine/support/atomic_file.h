@@ -28,7 +28,8 @@ void writeAtomically(const std::filesystem::path& file,
 
 /// Removes the temporaries that writes of `file` left behind when killed (temporaryBeside's
 /// names); returns how many. A write of the same file running now loses its temporary and
-/// fails cleanly.
+/// fails cleanly. Names longer than 233 bytes share their temporaries' prefix with any name
+/// that begins with the same 233 bytes.
 int removeStaleTemporaries(const std::filesystem::path& file);
 
 /// writeAtomically of `text`, checking that every byte reached the disk.

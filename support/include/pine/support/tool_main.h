@@ -16,6 +16,9 @@ namespace pine::tool {
 int run(const char* name, CLI::App& app, int argc, char** argv,
         const std::function<int()>& body);
 
+/// A finite number > 0 (CLI::PositiveNumber lets nan and inf through and prints DBL_MAX).
+CLI::Validator positiveNumber();
+
 /// The process's peak resident memory so far, in MiB (for the tools' summary lines).
 double peakMemoryMiB();
 

@@ -25,8 +25,8 @@ struct Fragment {
 /// How much of a footprint each tree's foliage covers: a few trees, the largest kept.
 template <int Slots>
 struct TreeShares {
-    int tree[Slots];
-    double weight[Slots];
+    int tree[Slots]{};
+    double weight[Slots]{};
     int count = 0;
 
     void add(int id, double w)

@@ -25,22 +25,21 @@ public:
             mCrossed = 1.0;  // outside the medium, or between boughs: the next span begins one
             return 1.0;
         }
+        const double crossings = std::abs(layers);
+        if (!(crossings > 0.0)) {  // along the layers: within the band, whichever way it runs
+            if (mCrossed >= 1.0) begin();
+            return stretch(needles);
+        }
         const double sign = layers < 0.0 ? -1.0 : 1.0;
         if (sign != mSign) {
             mSign = sign;
             mCrossed = 1.0;  // the line turned back through the layers: a new band
         }
-        const double crossings = std::abs(layers);
-        if (!(crossings > 0.0)) {  // along the layers: within one band
-            if (mCrossed >= 1.0) begin();
-            return stretch(needles);
-        }
-        const double perLayer = needles / crossings;
         double left = crossings, T = 1.0;
         while (left > 0.0 && T > 0.0) {
             if (mCrossed >= 1.0) begin();
             const double step = std::min(left, 1.0 - mCrossed);
-            T *= stretch(perLayer * step);
+            T *= stretch(needles * (step / crossings));  // no overflow for tiny crossings
             mCrossed += step;
             left -= step;
         }

@@ -38,7 +38,7 @@ struct TreeBias {
 };
 
 /// Every tree of the truth's "tree" AOV, `image` against `truth`; trees whose truth covers
-/// fewer than `minCoverage` pixels are left out (their ratios are noise).
+/// fewer than `minCoverage` pixels (or none) are left out (their ratios are noise).
 std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double minCoverage = 20.0);
 
 }  // namespace pine::vdbtrace
