@@ -67,28 +67,12 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
         fs::remove(tmp, ignored);
         return InputError("cannot write '" + file.string() + "': " + why);
     };
-    try {
-        write(tmp);
-    } catch (const std::bad_alloc&) {  // not the output's fault: not the user's error
-        fs::remove(tmp, ignored);
-        throw;
-    } catch (const std::exception& e) {
-        throw refuse(e.what());
-    } catch (...) {
-        fs::remove(tmp, ignored);
-        throw;
-    }
-    // The bytes on the disk before the name: a full disk fails here, not after the rename.
-    const int fd = ::open(tmp.c_str(), O_RDONLY);
-    if (fd < 0 || ::fsync(fd) != 0) {
-        const int why = errno;
-        if (fd >= 0) ::close(fd);
-        throw refuse(std::strerror(why));
-    }
-    ::close(fd);
-    if (beforeRename) {
+    // What a step throws becomes the user's error about this file, the temporary removed;
+    // running out of memory (not the output's fault) and non-standard exceptions pass as
+    // they are.
+    const auto step = [&](auto&& run) {
         try {
-            beforeRename();
+            run();
         } catch (const std::bad_alloc&) {
             fs::remove(tmp, ignored);
             throw;
@@ -98,7 +82,17 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
             fs::remove(tmp, ignored);
             throw;
         }
+    };
+    step([&] { write(tmp); });
+    // The bytes on the disk before the name: a full disk fails here, not after the rename.
+    const int fd = ::open(tmp.c_str(), O_RDONLY);
+    if (fd < 0 || ::fsync(fd) != 0) {
+        const int why = errno;
+        if (fd >= 0) ::close(fd);
+        throw refuse(std::strerror(why));
     }
+    ::close(fd);
+    if (beforeRename) step(beforeRename);
     std::error_code error;
     fs::rename(tmp, file, error);
     if (error) throw refuse(error.message());
