@@ -98,14 +98,17 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
     if (error) throw refuse(error.message());
 }
 
+void writeBytes(const fs::path& file, std::string_view bytes)
+{
+    std::ofstream out(file, std::ios::binary);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    out.close();
+    if (!out) throw std::runtime_error(std::strerror(errno));
+}
+
 void writeTextAtomically(const fs::path& file, const std::string& text)
 {
-    writeAtomically(file, [&](const fs::path& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        out.close();
-        if (!out) throw std::runtime_error(std::strerror(errno));
-    });
+    writeAtomically(file, [&](const fs::path& tmp) { writeBytes(tmp, text); });
 }
 
 namespace {

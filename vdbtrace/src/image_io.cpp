@@ -10,11 +10,9 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <string_view>
 #include <system_error>
 #include <vector>
@@ -118,13 +116,8 @@ void writeAtomically(const char* what, const char* format, const fs::path& path,
                     out->close();
                     throw std::runtime_error(why);
                 }
-                std::FILE* f = std::fopen(temporary.c_str(), "wb");
-                if (!f) throw std::runtime_error(std::strerror(errno));
-                const bool written = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-                const int why = errno;
-                if (std::fclose(f) != 0 || !written) {
-                    throw std::runtime_error(std::strerror(written ? errno : why));
-                }
+                io::writeBytes(temporary,
+                               {reinterpret_cast<const char*>(bytes.data()), bytes.size()});
                 return;
             }
             if (!out->open(temporary.string(), spec)) {

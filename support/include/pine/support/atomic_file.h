@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pine::io {
@@ -31,6 +32,11 @@ void writeAtomically(const std::filesystem::path& file,
 /// fails cleanly. Names longer than 233 bytes share their temporaries' prefix with any name
 /// that begins with the same 233 bytes.
 int removeStaleTemporaries(const std::filesystem::path& file);
+
+/// Writes `bytes` to `file` (created or truncated), every write and the close checked; throws
+/// std::runtime_error with the system's reason (a full disk). Not atomic by itself: the
+/// callback writeAtomically's writers call on their temporary.
+void writeBytes(const std::filesystem::path& file, std::string_view bytes);
 
 /// writeAtomically of `text`, checking that every byte reached the disk.
 void writeTextAtomically(const std::filesystem::path& file, const std::string& text);
