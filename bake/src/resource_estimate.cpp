@@ -1,9 +1,11 @@
 #include "pine/bake/resource_estimate.h"
 
+#include "pine/analytic/cone_shader.h"
 #include "pine/bake/tree_boughs.h"
 #include "pine/scenes/tree.h"
 #include "pine/support/input_error.h"
 
+#include <glm/geometric.hpp>
 #include <unistd.h>
 
 #include <algorithm>
@@ -25,7 +27,7 @@ constexpr double kBytesPerPixel = 96.0;
 constexpr double kBytesPerBranch = 200.0;
 constexpr double kBytesPerBough = 800.0, kBytesPerBoughLight = 1200.0;
 constexpr double kBytesPerNeedle = 220.0;
-constexpr double kBytesPerVoxel = 80.0;
+constexpr double kBytesPerVoxel = 80.0, kBytesPerVoxelLight = 8.0;
 constexpr double kProgramBytes = 150.0 * 1024 * 1024;  // its libraries, before any scene
 constexpr const char* kProgram = "the program";
 
@@ -41,10 +43,8 @@ TreeSample sampleTree(const scenes::Scene& scene, const scenes::TreePlacement& p
     s.needles = counts.needles;
     for (const BoughSpec& b : treeBoughs(tree)) {
         const analytic::ConeGeometry& c = b.needles.cone;
-        const double R = c.needleLength_cm * std::sin(c.aperture_rad);
-        const double length = std::sqrt((b.tip_cm.x - b.base_cm.x) * (b.tip_cm.x - b.base_cm.x) +
-                                        (b.tip_cm.y - b.base_cm.y) * (b.tip_cm.y - b.base_cm.y) +
-                                        (b.tip_cm.z - b.base_cm.z) * (b.tip_cm.z - b.base_cm.z));
+        const double R = analytic::boughRadius(c);  // l sin(phi)
+        const double length = glm::length(b.tip_cm - b.base_cm);
         s.boughVolume_cm3 +=
             kPi * R * R * (length + c.needleLength_cm * std::cos(c.aperture_rad));
     }
@@ -99,7 +99,7 @@ void addVoxels(ResourceEstimate& e, const TreeSample& trees, double voxelSize_cm
     char size[32];
     std::snprintf(size, sizeof size, "%.3g cm", voxelSize_cm);
     e.parts.push_back({count(voxels) + " voxels of " + size,
-                       voxels * (kBytesPerVoxel + 4.0 * lights)});
+                       voxels * (kBytesPerVoxel + kBytesPerVoxelLight * lights)});
 }
 
 }  // namespace
@@ -131,7 +131,7 @@ const ResourceEstimate::Part& ResourceEstimate::largest() const
 }
 
 ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
-                                double voxelSize_cm)
+                                double voxelSize_cm, double voxelsRead)
 {
     ResourceEstimate e;
     e.parts.push_back({kProgram, kProgramBytes});
@@ -149,7 +149,11 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
         e.parts.push_back({count(trees.needles) + " needle cylinders",
                            trees.needles * kBytesPerNeedle});
     } else if (method == "reference") {
-        addVoxels(e, trees, voxelSize_cm, lights);
+        if (voxelsRead > 0.0) {
+            e.parts.push_back({"light grids", voxelsRead * kBytesPerVoxelLight * lights});
+        } else {
+            addVoxels(e, trees, voxelSize_cm, lights);
+        }
     }
     return e;
 }

@@ -165,16 +165,10 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                   << baked->voxelSize_cm << " cm read\n";
     }
     const auto loaded = load(sceneFile, model, [&](const scenes::Scene& scene) {
-        // Grids read from files are already in memory: the image, the trees and the light
-        // reaching each of their voxels remain.
-        bake::ResourceEstimate need =
-            bake::estimateRender(scene, baked ? "multiscale" : methodName, settings.voxelSize_cm);
-        if (baked) {
-            const double lights = double(scene.pointLights.size() + scene.directionalLights.size());
-            need.parts.push_back(
-                {"light grids", double(baked->layerOpacity->activeVoxelCount()) * 8.0 * lights});
-        }
-        bake::checkMemory(need, bake::memoryLimit(maxMemoryGiB), sceneFile.string());
+        const double voxelsRead = baked ? double(baked->layerOpacity->activeVoxelCount()) : 0.0;
+        bake::checkMemory(
+            bake::estimateRender(scene, methodName, settings.voxelSize_cm, voxelsRead),
+            bake::memoryLimit(maxMemoryGiB), sceneFile.string());
     });
     std::cerr << "vdbtrace: " << sceneFile.string() << ": "
               << describe(loaded->scene, loaded->traced) << '\n';

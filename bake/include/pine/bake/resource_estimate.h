@@ -30,11 +30,13 @@ struct TreeTotals {
 TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size_t>& trees);
 
 /// The memory a render of `scene` by method `method` ("multiscale", "reference", "geometry")
-/// will need, within a factor of about 1.5 of the peaks measured (docs/vdbtrace.md): the image and its outputs, the trees as the
-/// tracer holds them, and the method's own (explicit needles; voxels of `voxelSize_cm`). Each
-/// species is grown once, for its first placement, which stands for all of its placements.
+/// will need, within a factor of about 1.5 of the peaks measured (docs/vdbtrace.md): the image
+/// and its outputs, the trees as the tracer holds them, and the method's own (explicit needles;
+/// the reference's voxels of `voxelSize_cm` with the light reaching each, or with
+/// `voxelsRead` > 0, grids already read, only that light). Each species is grown once, for its
+/// first placement, which stands for all of its placements.
 ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
-                                double voxelSize_cm);
+                                double voxelSize_cm, double voxelsRead = 0.0);
 
 /// The memory a bake of `trees` (indices into scene.trees) at `voxelSize_cm` will need, with
 /// up to `concurrent` trees in memory at once (each written before the next).
