@@ -63,8 +63,7 @@ std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int
         throw ImageError("tree regions of " + std::to_string(regions.size()) +
                          " pixels for an image of " + std::to_string(foliage.size()));
     }
-    std::map<int, TreeFoliage> trees;
-    std::map<int, double> weighted;
+    std::map<int, TreeFoliage> trees;  // luminance holds sum(luminance x foliage) until the end
     for (std::size_t i = 0; i < regions.size(); ++i) {
         if (regions[i] < 0) continue;
         TreeFoliage& t = trees[regions[i]];
@@ -72,11 +71,11 @@ std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int
         ++t.pixels;
         const float* p = &image.rgba[4 * i];
         t.coverage += foliage[i];
-        weighted[regions[i]] += luminance(Vec3(p[0], p[1], p[2])) * foliage[i];
+        t.luminance += luminance(Vec3(p[0], p[1], p[2])) * foliage[i];
     }
     std::vector<TreeFoliage> out;
     for (auto& [id, t] : trees) {
-        t.luminance = t.coverage > 0.0 ? weighted[id] / t.coverage : 0.0;
+        t.luminance = t.coverage > 0.0 ? t.luminance / t.coverage : 0.0;
         out.push_back(t);
     }
     return out;
