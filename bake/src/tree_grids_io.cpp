@@ -4,7 +4,9 @@
 
 #include "manifest.h"
 #include "pine/bake/extinction_law.h"
+#include "pine/bake/resource_estimate.h"
 #include "pine/support/atomic_file.h"
+#include "pine/support/isolated_process.h"
 
 #include <openvdb/io/Stream.h>
 
@@ -12,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <sstream>
+#include <system_error>
 
 #ifndef PINE_TOOL_VERSION
 #define PINE_TOOL_VERSION "unknown"
@@ -153,12 +156,11 @@ void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
     });
 }
 
-TreeGrids readTreeGrids(const fs::path& path)
-{
-    openvdb::initialize();
-    // Refused before OpenVDB sees a byte: a damaged .vdb can crash OpenVDB 10.0.1 (DESIGN.md).
-    const std::string bytes = detail::readVerified(path);
+namespace {
 
+/// The grids in `bytes`, read from `path`, checked as readTreeGrids promises.
+TreeGrids parseTreeGrids(const std::string& bytes, const fs::path& path)
+{
     openvdb::GridPtrVecPtr grids;
     openvdb::MetaMap::Ptr meta;
     try {
@@ -205,6 +207,32 @@ TreeGrids readTreeGrids(const fs::path& path)
     out.densityScale_per_cm = scale->value();
     out.voxelSize_cm = out.density->voxelSize()[0];
     return out;
+}
+
+}  // namespace
+
+TreeGrids readTreeGrids(const fs::path& path, double maxMemoryBytes)
+{
+    openvdb::initialize();
+    // Refused before OpenVDB sees a byte: a damaged .vdb can crash OpenVDB 10.0.1 (DESIGN.md).
+    const std::string bytes = detail::readVerified(path);
+    // A matching manifest says the bytes are those someone wrote, not that OpenVDB survives
+    // them (a file edited or produced elsewhere comes with one), so they are parsed first in a
+    // child process, its memory limited, where a crash or a runaway allocation is an answer.
+    const io::IsolationLimits limits{maxMemoryBytes > 0.0 ? maxMemoryBytes : defaultMemoryLimit(),
+                                     60.0 + double(bytes.size()) / 1e7};
+    io::IsolatedOutcome trial;
+    try {
+        trial = io::runIsolated([&] { (void)parseTreeGrids(bytes, path); }, limits);
+    } catch (const std::system_error& e) {
+        throw BakeError("cannot read '" + path.string() + "': " + e.what());
+    }
+    if (trial.kind == io::IsolatedOutcome::Kind::Threw) throw BakeError(trial.why);
+    if (!trial.returned()) {
+        throw BakeError("cannot read '" + path.string() + "': OpenVDB " + trial.why +
+                        " on it (damaged?)");
+    }
+    return parseTreeGrids(bytes, path);
 }
 
 }  // namespace pine::bake

@@ -10,6 +10,8 @@
 #include <openvdb/io/Stream.h>
 
 #include <algorithm>
+#include <iostream>
+#include <random>
 #include <cstdlib>
 #include <iterator>
 #include <fstream>
@@ -294,6 +296,52 @@ TEST(TreeGridsIo, WhatOpenVdbCannotReadIsABakeError)
     writeFile(file, "this is not a vdb file, though its manifest says it is fine\n");
     writeMatchingManifest(file);
     expectRefused(file, "cannot read");
+}
+
+TEST(TreeGridsIo, DamagedBytesWithAMatchingManifestAreRefusedNeverFatal)
+{
+    // A file edited elsewhere comes with a manifest that matches its bytes. OpenVDB 10.0.1
+    // crashes on some such damage (SIGSEGV on a flipped byte, SIGBUS on a zeroed block, an abort
+    // on a corrupted heap) or allocates gigabytes: whatever the damage, the read returns or
+    // throws BakeError, and this process survives it (it did not before reads were isolated).
+    const test::TempDir dir;
+    const fs::path good = written(dir);
+    const std::string bytes = readFile(good);
+    const fs::path file = dir.path() / "damaged.vdb";
+    std::mt19937_64 rng(3);  // its trial 21 aborts OpenVDB 10.0.1 (malloc: heap corrupted)
+    int refused = 0, read = 0, fatal = 0;  // fatal: crashed or ran out of memory in the child
+    std::string lastWhy;
+    for (int trial = 0; trial < 40; ++trial) {
+        std::string damaged = bytes;
+        // Half of the damage in the first 2 KiB: the header, metadata and first topology.
+        const std::size_t at = rng() % (trial % 8 < 4 ? std::min<std::size_t>(2048, damaged.size())
+                                                      : damaged.size());
+        switch (trial % 4) {
+        case 0: damaged[at] = char(damaged[at] ^ (1 << (rng() % 8))); break;
+        case 1: damaged.replace(at, std::min<std::size_t>(4096, damaged.size() - at),
+                                std::min<std::size_t>(4096, damaged.size() - at), '\0'); break;
+        case 2: damaged.resize(at); break;
+        case 3:  // a size or count field made huge
+            for (int i = 0; i < 4 && at + i < damaged.size(); ++i) damaged[at + i] = char(0x7f);
+            break;
+        }
+        writeFile(file, damaged);
+        writeMatchingManifest(file);
+        try {
+            (void)readTreeGrids(file, 512.0 * 1024 * 1024);
+            ++read;
+        } catch (const BakeError& e) {
+            ++refused;
+            lastWhy = e.what();
+            if (lastWhy.find("OpenVDB") != std::string::npos) ++fatal;
+            EXPECT_NE(lastWhy.find("damaged.vdb"), std::string::npos) << lastWhy;
+            EXPECT_EQ(lastWhy.find('\n'), std::string::npos) << lastWhy;
+        }
+    }
+    EXPECT_EQ(read + refused, 40);
+    EXPECT_GT(refused, 20) << "most damage must be seen";
+    std::cout << read << " damaged files read, " << refused << " refused (" << fatal
+              << " that would have crashed this process or exhausted its memory)\n";
 }
 
 TEST(TreeGridsIo, AnotherFormatVersionOrAnUnknownLawIsRefused)

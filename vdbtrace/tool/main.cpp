@@ -158,7 +158,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     std::optional<bake::TreeGrids> baked;
     if (methodName == "reference" && !gridFiles.empty()) {
         std::vector<bake::TreeGrids> trees;
-        for (const fs::path& file : gridFiles) trees.push_back(bake::readTreeGrids(file));
+        for (const fs::path& file : gridFiles) {
+            trees.push_back(bake::readTreeGrids(file, bake::memoryLimit(maxMemoryGiB)));
+        }
         baked = bake::mergeTreeGrids(trees);  // files bake wrote, checked against manifests
         settings.grids = &*baked;
         std::cerr << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "

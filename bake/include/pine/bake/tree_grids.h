@@ -124,8 +124,10 @@ void writeTreeGrids(const TreeGrids& grids, const std::filesystem::path& path,
 /// Reads grids written by writeTreeGrids, after checking the manifest's size and checksum:
 /// a damaged or foreign file is refused with BakeError, never opened by OpenVDB. Refuses a file
 /// of another format version or of an extinction law not registered here. Also catches what
-/// OpenVDB throws.
-TreeGrids readTreeGrids(const std::filesystem::path& path);
+/// OpenVDB throws. A file whose manifest matches (edited or produced elsewhere) is parsed first
+/// in a child process with at most `maxMemoryBytes` (0: defaultMemoryLimit()): where OpenVDB
+/// crashes, hangs or runs out of memory on it, BakeError says so. Call it before parallel work.
+TreeGrids readTreeGrids(const std::filesystem::path& path, double maxMemoryBytes = 0.0);
 
 }  // namespace pine::bake
 
