@@ -6,9 +6,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 namespace pine::bake::detail {
 
@@ -49,15 +51,52 @@ FileDigest digestFile(const fs::path& file)
 
 fs::path manifestPath(const fs::path& file) { return fs::path(file.string() + ".json"); }
 
-void writeManifest(const fs::path& file, const FileDigest& digest)
+namespace {
+
+nlohmann::json toJson(const FileDigest& digest)
 {
-    const nlohmann::json j = {{"file", file.filename().string()},
-                              {"bytes", digest.bytes},
-                              {"fnv1a64", Fnv1a64::hex(digest.fnv1a64)}};
+    return {{"bytes", digest.bytes}, {"fnv1a64", Fnv1a64::hex(digest.fnv1a64)}};
+}
+
+/// A digest as recorded: bytes and the checksum's hex digits. Throws nlohmann::json::exception.
+struct Recorded {
+    std::uintmax_t bytes = 0;
+    std::string fnv1a64;
+};
+Recorded recorded(const nlohmann::json& j)
+{
+    return {j.at("bytes").get<std::uintmax_t>(), j.at("fnv1a64").get<std::string>()};
+}
+
+}  // namespace
+
+void writeManifest(const fs::path& file, const FileDigest& digest,
+                   const std::optional<FileDigest>& previous)
+{
+    nlohmann::json j = toJson(digest);
+    j["file"] = file.filename().string();
+    if (previous) j["previous"] = toJson(*previous);
     try {
         io::writeTextAtomically(manifestPath(file), j.dump(2) + "\n");
     } catch (const InputError& e) {
         throw BakeError(e.what());
+    }
+}
+
+std::optional<FileDigest> acceptedDigest(const fs::path& file)
+{
+    std::error_code error;
+    if (!fs::exists(file, error)) return std::nullopt;
+    try {
+        const std::string bytes = readVerified(file);
+        Fnv1a64 hash;
+        hash.update(bytes);
+        FileDigest digest;
+        digest.bytes = bytes.size();
+        digest.fnv1a64 = hash.value();
+        return digest;
+    } catch (const BakeError&) {
+        return std::nullopt;
     }
 }
 
@@ -69,17 +108,17 @@ std::string readVerified(const fs::path& file)
     };
     const fs::path manifest = manifestPath(file);
     std::error_code error;
+    if (!fs::exists(file, error)) throw BakeError("'" + file.string() + "': no such file");
     if (!fs::is_regular_file(manifest, error)) {
         throw refuse("no manifest '" + manifest.filename().string() + "' beside it");
     }
-    std::string expectedHash;
-    std::uintmax_t expectedBytes = 0;
+    std::vector<Recorded> accepted;  // this file's digest, then the one it replaces if recorded
     try {
         std::ifstream in(manifest);
         const nlohmann::json j = nlohmann::json::parse(in);
         (void)j.at("file").get<std::string>();
-        expectedBytes = j.at("bytes").get<std::uintmax_t>();
-        expectedHash = j.at("fnv1a64").get<std::string>();
+        accepted.push_back(recorded(j));
+        if (j.contains("previous")) accepted.push_back(recorded(j.at("previous")));
     } catch (const nlohmann::json::exception& e) {
         throw refuse("unreadable manifest: " + std::string(e.what()));
     }
@@ -87,9 +126,10 @@ std::string readVerified(const fs::path& file)
     // with its manifest is still accepted.
     const std::uintmax_t bytes = fs::file_size(file, error);
     if (error) throw refuse("cannot read it: " + error.message());
-    if (bytes != expectedBytes) {
+    if (std::none_of(accepted.begin(), accepted.end(),
+                     [&](const Recorded& r) { return r.bytes == bytes; })) {
         throw refuse(std::to_string(bytes) + " bytes, the manifest says " +
-                     std::to_string(expectedBytes));
+                     std::to_string(accepted.front().bytes));
     }
     // Read once, check, and hand OpenVDB these very bytes: the file cannot change in between.
     std::string content(bytes, '\0');
@@ -100,9 +140,11 @@ std::string readVerified(const fs::path& file)
     }
     Fnv1a64 hash;
     hash.update(content);
-    if (Fnv1a64::hex(hash.value()) != expectedHash) {
-        throw refuse("checksum " + Fnv1a64::hex(hash.value()) + ", the manifest says " +
-                     expectedHash);
+    const std::string hex = Fnv1a64::hex(hash.value());
+    if (std::none_of(accepted.begin(), accepted.end(), [&](const Recorded& r) {
+            return r.bytes == bytes && r.fnv1a64 == hex;
+        })) {
+        throw refuse("checksum " + hex + ", the manifest says " + accepted.front().fnv1a64);
     }
     return content;
 }

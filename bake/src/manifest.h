@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -31,11 +32,18 @@ FileDigest digestFile(const std::filesystem::path& file);
 
 std::filesystem::path manifestPath(const std::filesystem::path& file);
 
-/// Writes `file`'s manifest atomically (temporary file, then rename). Throws BakeError.
-void writeManifest(const std::filesystem::path& file, const FileDigest& digest);
+/// Writes `file`'s manifest atomically (temporary file, then rename). With `previous`, the
+/// manifest also accepts the file it is about to replace: put in place before the new file,
+/// it keeps the pair whole if the writer is killed between the two renames. Throws BakeError.
+void writeManifest(const std::filesystem::path& file, const FileDigest& digest,
+                   const std::optional<FileDigest>& previous = std::nullopt);
 
-/// The bytes of `file`, once its manifest is found and its size and checksum match it.
-/// Throws BakeError "'FILE' does not match its manifest (written by bake?): WHY".
+/// The digest of `file` if it exists and its manifest accepts it (readVerified).
+std::optional<FileDigest> acceptedDigest(const std::filesystem::path& file);
+
+/// The bytes of `file`, once its manifest is found and its size and checksum match it (or
+/// match the previous file it records). Throws BakeError "'FILE' does not match its manifest
+/// (written by bake?): WHY".
 std::string readVerified(const std::filesystem::path& file);
 
 }  // namespace pine::bake::detail

@@ -6,6 +6,7 @@
 #include "pine/bake/extinction_law.h"
 #include "pine/bake/resource_estimate.h"
 #include "pine/support/atomic_file.h"
+#include "pine/support/folder_lock.h"
 #include "pine/support/isolated_process.h"
 
 #include <openvdb/io/Stream.h>
@@ -13,6 +14,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <sstream>
 #include <system_error>
 
@@ -135,13 +137,18 @@ void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
         list.push_back(densityForWriting(*lod, grids.densityScale_per_cm, meta));
     }
 
-    // Written under a temporary name beside the target, synced, then renamed: a crash or an
-    // error never leaves a half-written file under the final name (DESIGN.md). The manifest
-    // goes in first: a grid under its final name always has its own manifest, or (killed
-    // between the two renames) a newer one that refuses it, never an older one that matches
-    // the file it replaced. What a killed bake left behind goes first.
+    // Runs writing into this folder take turns: each grid and manifest pair then comes from
+    // one run, and the stale temporaries removed here are a killed run's, not a live one's.
+    std::optional<io::FolderLock> turn;
+    asBakeError([&] { turn.emplace(io::FolderLock::of(path)); });
     io::removeStaleTemporaries(path);
     io::removeStaleTemporaries(detail::manifestPath(path));
+    // Written under a temporary name beside the target, synced, then renamed: a crash or an
+    // error never leaves a half-written file under the final name (DESIGN.md). The manifest
+    // goes in first, accepting both the new grid and the one it replaces, so that a kill
+    // between the renames leaves a matching pair; then it is written again for the new grid
+    // alone.
+    const std::optional<detail::FileDigest> replaced = detail::acceptedDigest(path);
     detail::FileDigest digest;
     asBakeError([&] {
         io::writeAtomically(
@@ -152,8 +159,15 @@ void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
                 file.close();
                 digest = detail::digestFile(tmp);
             },
-            [&] { detail::writeManifest(path, digest); });
+            [&] { detail::writeManifest(path, digest, replaced); });
     });
+    if (replaced) {
+        // A failure here leaves a manifest that still matches the new grid: not an error.
+        try {
+            detail::writeManifest(path, digest);
+        } catch (const BakeError&) {
+        }
+    }
 }
 
 namespace {

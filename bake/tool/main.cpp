@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -19,6 +20,7 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 namespace {
 
@@ -96,6 +98,7 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
               const fs::path& dir, double maxMemoryGiB)
 {
     const auto start = std::chrono::steady_clock::now();
+    io::checkWritableFolder(dir);
     io::checkWritable(treeFile(dir, 0));
     const scenes::Scene scene = scenes::loadScene(sceneFile);
     const bake::BakeSettings settings = forScene(common, law, scene);
@@ -122,6 +125,51 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
     if (gProgressOpen.exchange(false)) std::fputc('\n', stderr);
     summarize(totals, start);
     return 0;
+}
+
+/// The .vdb files among `paths`, a folder standing for the .vdb files in it (sorted).
+std::vector<fs::path> vdbFiles(const std::vector<fs::path>& paths)
+{
+    std::vector<fs::path> files;
+    for (const fs::path& path : paths) {
+        std::error_code error;
+        if (!fs::is_directory(path, error)) {
+            files.push_back(path);
+            continue;
+        }
+        std::vector<fs::path> inside;
+        for (fs::directory_iterator it(path, error), end; !error && it != end;
+             it.increment(error)) {
+            if (it->path().extension() == ".vdb") inside.push_back(it->path());
+        }
+        if (error) throw InputError("cannot list '" + path.string() + "': " + error.message());
+        std::sort(inside.begin(), inside.end());
+        files.insert(files.end(), inside.begin(), inside.end());
+    }
+    return files;
+}
+
+/// Reads every file as a render would (manifest, then OpenVDB in a child process): one line
+/// each, status 2 if any is refused.
+int verify(const std::vector<fs::path>& paths, double maxMemoryGiB)
+{
+    const std::vector<fs::path> files = vdbFiles(paths);
+    if (files.empty()) throw InputError("no .vdb files in what was given");
+    int refused = 0;
+    for (const fs::path& file : files) {
+        try {
+            const bake::TreeGrids grids = bake::readTreeGrids(file, bake::memoryLimit(maxMemoryGiB));
+            std::cout << file.string() << ": ok, " << grids.density->activeVoxelCount()
+                      << " voxels of " << grids.voxelSize_cm << " cm, extinction law "
+                      << grids.extinctionLaw << "\n";
+        } catch (const InputError& e) {
+            std::cout << file.string() << ": refused: " << e.what() << "\n";
+            ++refused;
+        }
+    }
+    std::cerr << "bake: " << files.size() - std::size_t(refused) << " of " << files.size()
+              << " files read whole\n";
+    return refused == 0 ? 0 : 2;
 }
 
 }  // namespace
@@ -164,11 +212,21 @@ int main(int argc, char** argv)
 
     auto* sceneCmd = app.add_subcommand("scene", "Bake every tree: DIR/tree_000.vdb, ...");
     addCommon(sceneCmd);
-    sceneCmd->add_option("--out-dir", outDir, "Existing output folder")->required();
+    sceneCmd->add_option("--out-dir", outDir, "Output folder (created if missing)")->required();
+
+    std::vector<fs::path> verifyPaths;
+    auto* verifyCmd = app.add_subcommand(
+        "verify", "Check baked files as a render reads them (manifest, then OpenVDB isolated)");
+    verifyCmd->add_option("paths", verifyPaths, ".vdb files, or folders of them")->required();
+    verifyCmd->add_option("--max-memory", maxMemoryGiB,
+                          "Memory OpenVDB may use to read one file, in GiB (default: 80% of "
+                          "this machine's)")
+        ->check(positive);
 
     return tool::run("bake", app, argc, argv, [&] {
         try {
             if (*treeCmd) return bakeOne(sceneFile, tree, settings, law, out, maxMemoryGiB);
+            if (*verifyCmd) return verify(verifyPaths, maxMemoryGiB);
             return bakeScene(sceneFile, settings, law, outDir, maxMemoryGiB);
         } catch (...) {
             if (gProgressOpen.exchange(false)) std::fputc('\n', stderr);  // the error's own line

@@ -68,11 +68,15 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
         return InputError("cannot write '" + file.string() + "': " + why);
     };
     // What a step throws becomes the user's error about this file, the temporary removed;
-    // running out of memory (not the output's fault) and non-standard exceptions pass as
-    // they are.
-    const auto step = [&](auto&& run) {
+    // running out of memory (not the output's fault), non-standard exceptions and what
+    // beforeRename's own writes say of their files (InputError) pass as they are.
+    const auto step = [&](auto&& run, bool passInputErrors) {
         try {
             run();
+        } catch (const InputError& e) {
+            if (!passInputErrors) throw refuse(e.what());
+            fs::remove(tmp, ignored);
+            throw;
         } catch (const std::bad_alloc&) {
             fs::remove(tmp, ignored);
             throw;
@@ -83,7 +87,7 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
             throw;
         }
     };
-    step([&] { write(tmp); });
+    step([&] { write(tmp); }, false);
     // The bytes on the disk before the name: a full disk fails here, not after the rename.
     const int fd = ::open(tmp.c_str(), O_RDONLY);
     if (fd < 0 || ::fsync(fd) != 0) {
@@ -92,7 +96,7 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
         throw refuse(std::strerror(why));
     }
     ::close(fd);
-    if (beforeRename) step(beforeRename);
+    if (beforeRename) step(beforeRename, true);
     std::error_code error;
     fs::rename(tmp, file, error);
     if (error) throw refuse(error.message());

@@ -14,7 +14,7 @@ printf '{"camera": {' >"$work/broken.json"
 expect_error "malformed scene" 2 "broken.json:1:" -- tree "$work/broken.json" --tree 0 --voxel-size 1 --out "$work/a.vdb"
 expect_error "malformed scene, all trees" 2 "broken.json:1:" -- scene "$work/broken.json" --voxel-size 1 --out-dir "$work"
 expect_error "unwritable output" 2 "no/such/dir" -- tree "$bough" --tree 0 --voxel-size 1 --out "$work/no/such/dir/a.vdb"
-expect_error "missing output folder" 2 "no/such/dir" -- scene "$bough" --voxel-size 1 --out-dir "$work/no/such/dir"
+expect_error "output folder that cannot be made" 2 "broken.json/dir" -- scene "$bough" --voxel-size 1 --out-dir "$work/broken.json/dir"
 # The output is checked before the scene is read, and before any work.
 expect_error "unwritable output, bad scene" 2 "no/such/dir" -- tree "$work/broken.json" --tree 0 --voxel-size 1 --out "$work/no/such/dir/a.vdb"
 expect_error "no such tree" 2 "no tree 5" -- tree "$bough" --tree 5 --voxel-size 1 --out "$work/a.vdb"
@@ -35,6 +35,22 @@ cmp -s "$bough" "$work/inplace/tree_000.vdb" || fail "a refused bake changed the
 [ "$(ls "$work/inplace")" = tree_000.vdb ] || fail "a refused bake left files: $(ls "$work/inplace")"
 rm -r "$work/inplace"
 [ -z "$(ls -A "$work" | grep -v -e '^out$' -e '^err$' -e '^broken.json$')" ] || fail "failed runs left files: $(ls -A "$work")"
+# A missing output folder is made, as with mkdir -p.
+"$tool" scene "$bough" --voxel-size 1 --out-dir "$work/new/dir" 2>/dev/null \
+    && [ -f "$work/new/dir/tree_000.vdb" ] || fail "bake scene did not make its output folder"
+rm -r "$work/new"
+# verify: one line per file, status 2 when any is refused.
+mkdir "$work/v"
+"$tool" tree "$bough" --tree 0 --voxel-size 1 --out "$work/v/a.vdb" 2>/dev/null
+cp "$work/v/a.vdb" "$work/v/b.vdb"
+printf 'x' >>"$work/v/b.vdb"
+cp "$work/v/a.vdb.json" "$work/v/b.vdb.json"
+"$tool" verify "$work/v" >"$work/out" 2>"$work/err"
+[ $? -eq 2 ] || fail "verify of a damaged file: exit status is not 2"
+grep -q "a.vdb: ok, " "$work/out" || fail "verify: $(cat "$work/out")"
+grep -q "b.vdb: refused: .*bytes, the manifest says" "$work/out" || fail "verify: $(cat "$work/out")"
+grep -q "1 of 2 files read whole" "$work/err" || fail "verify: $(cat "$work/err")"
+rm -r "$work/v"
 
 # One tree: the .vdb and its manifest; one summary line.
 "$bake" tree "$bough" --tree 0 --voxel-size 0.5 --out "$work/b.vdb" 2>"$work/err" \

@@ -38,13 +38,15 @@ tail -1 "$work/err" | grep -q "b.exr" || fail "EXR onto a full disk: $(tail -1 "
 [ -z "$(leftovers)" ] || fail "temporaries left: $(leftovers)"
 
 # Room for the EXR, not for its PNG: the PNG is refused, the previous one kept (libpng alone
-# does not report a short write).
+# does not report a short write), and so is the previous EXR: no new EXR beside an old preview.
 mount_disk $((exr + png / 2))
 echo old >"$disk/b.png"
+echo old >"$disk/b.exr"
 "$vdbtrace" render "$scene" --out "$disk/b.exr" >"$work/out" 2>"$work/err"
 [ $? -eq 2 ] || fail "PNG onto a full disk: exit status is not 2"
 tail -1 "$work/err" | grep -q "b.png" || fail "PNG onto a full disk: $(tail -1 "$work/err")"
 [ "$(cat "$disk/b.png")" = old ] || fail "a failed PNG write replaced the previous file"
+[ "$(cat "$disk/b.exr")" = old ] || fail "a failed PNG write left a new EXR beside the old PNG"
 [ -z "$(leftovers)" ] || fail "temporaries left: $(leftovers)"
 
 # bake: the previous grid and manifest stay a matching pair.

@@ -92,7 +92,8 @@ bool isStandardAttribute(std::string_view key)
 /// Writes pixels as `format` through the shared atomic writer (support/atomic_file.h): never
 /// half-written under `path`.
 void writeAtomically(const char* what, const char* format, const fs::path& path,
-                     const OIIO::ImageSpec& spec, const void* pixels)
+                     const OIIO::ImageSpec& spec, const void* pixels,
+                     const std::function<void()>& beforeRename = {})
 {
     // libpng does not say when the disk is full (a truncated PNG, status 0, was seen): a
     // format that can is written to memory first and its bytes written here, each checked.
@@ -129,7 +130,9 @@ void writeAtomically(const char* what, const char* format, const fs::path& path,
                 throw std::runtime_error(why);
             }
             if (!out->close()) throw std::runtime_error(oneLine(out->geterror()));
-        });
+        }, beforeRename);
+    } catch (const ImageError&) {
+        throw;  // another image's, written by beforeRename
     } catch (const InputError& e) {
         throw ImageError(std::string(what) + ": " + e.what());
     }
@@ -178,7 +181,8 @@ void writeBytesPng(const char* what, const fs::path& path, int width, int height
 
 }  // namespace
 
-void writeExr(const Image& image, const std::filesystem::path& path, const Metadata& metadata)
+void writeExr(const Image& image, const std::filesystem::path& path, const Metadata& metadata,
+              const std::function<void()>& beforeRename)
 {
     constexpr const char* what = "writeExr";
     checkShape(image, what, path);
@@ -213,7 +217,7 @@ void writeExr(const Image& image, const std::filesystem::path& path, const Metad
         std::size_t c = 4;
         for (const auto& entry : image.aovs) out[c++] = entry.second[p];
     }
-    writeAtomically(what, "openexr", path, spec, interleaved.data());
+    writeAtomically(what, "openexr", path, spec, interleaved.data(), beforeRename);
 }
 
 void writePng(const Image& image, const std::filesystem::path& path)

@@ -5,6 +5,7 @@
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/support/atomic_file.h"
+#include "pine/support/folder_lock.h"
 #include "pine/support/plot_script.h"
 #include "pine/support/tool_main.h"
 #include "pine/vdbtrace/compare.h"
@@ -204,23 +205,37 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     for (const auto& [key, value] : methodSettings.items()) {
         metadata.emplace_back("pine:" + key, value.dump());
     }
-    vdbtrace::writeExr(result.image, out, metadata);
-    // The preview shows the scene's background behind what the cone did not cover.
-    vdbtrace::writePreviewPng(result.image, s.render.background, besideWith(out, ".png"));
-    for (const std::string& aov : aovs) {
-        if (aov == "level") vdbtrace::writeLevelPng(result.image, besideWith(out, ".level.png"));
+    // The previews and stats are put in place before the EXR, so that a failure among them
+    // leaves the previous EXR and never a new one beside an old preview. Runs writing into
+    // one folder take turns, so that these files come from one run.
+    const auto writeBeside = [&] {
+        // The preview shows the scene's background behind what the cone did not cover.
+        vdbtrace::writePreviewPng(result.image, s.render.background, besideWith(out, ".png"));
+        for (const std::string& aov : aovs) {
+            if (aov == "level") {
+                vdbtrace::writeLevelPng(result.image, besideWith(out, ".level.png"));
+            }
+        }
+        if (!statsFile.empty()) {
+            nlohmann::json j = vdbtrace::toJson(result.stats);
+            j["seconds"] = result.seconds;
+            j["scene"] = sceneFile.string();
+            j["method"] = methodName;
+            j["effects"] = effects;
+            j["resolution"] = {s.camera.width, s.camera.height};
+            j["threads"] = tbb::this_task_arena::max_concurrency();
+            j.update(methodSettings);
+            vdbtrace::writeJsonAtomically(j, statsFile);
+        }
+    };
+    const io::FolderLock turn(io::FolderLock::of(out), [&] {
+        std::cerr << "vdbtrace: waiting for another run writing into '"
+                  << io::FolderLock::of(out).string() << "'\n";
+    });
+    for (const fs::path& file : {out, besideWith(out, ".png"), besideWith(out, ".level.png")}) {
+        io::removeStaleTemporaries(file);  // a killed run's: live ones wait for the lock
     }
-    if (!statsFile.empty()) {
-        nlohmann::json j = vdbtrace::toJson(result.stats);
-        j["seconds"] = result.seconds;
-        j["scene"] = sceneFile.string();
-        j["method"] = methodName;
-        j["effects"] = effects;
-        j["resolution"] = {s.camera.width, s.camera.height};
-        j["threads"] = tbb::this_task_arena::max_concurrency();
-        j.update(methodSettings);
-        vdbtrace::writeJsonAtomically(j, statsFile);
-    }
+    vdbtrace::writeExr(result.image, out, metadata, writeBeside);
     const auto& st = result.stats;
     std::cerr << "vdbtrace: " << out.string() << ": " << s.camera.width << "x" << s.camera.height
               << " in " << result.seconds << " s, " << st.coneRays << " cone rays, "

@@ -115,9 +115,10 @@ struct BakeProvenance {
 /// Writes the grids atomically (temporary file in the same folder, synced, then renamed) with
 /// file metadata (format version, units, extinction law and its formula, voxel size, scene,
 /// tree, seed, tool version) and a manifest `PATH.json` beside it recording the file's size
-/// and checksum, put in place before the grid: if writing either fails the previous pair stays,
-/// and a kill or a failed rename between the two leaves a grid its new manifest refuses. Removes the temporaries of a
-/// killed earlier write first. Throws BakeError.
+/// and checksum, put in place before the grid (accepting the grid it replaces too, until the
+/// grid is renamed): if writing either fails or the bake is killed, a grid under its final name
+/// matches its manifest. Runs writing into one folder take turns (io::FolderLock). Removes the
+/// temporaries of a killed earlier write first. Throws BakeError.
 void writeTreeGrids(const TreeGrids& grids, const std::filesystem::path& path,
                     const BakeProvenance& provenance);
 

@@ -21,8 +21,9 @@ std::filesystem::path temporaryBeside(const std::filesystem::path& file);
 /// calling beforeRename() if given (what must be in place before `file` is: a manifest), then
 /// renaming the temporary onto `file`. If write or beforeRename throws or the rename fails,
 /// the temporary is removed and `file` is left as it was; throws InputError "cannot write
-/// 'FILE': WHY" (WHY from what the callback threw), except for std::bad_alloc and non-standard
-/// exceptions, rethrown as they are.
+/// 'FILE': WHY" (WHY from what the callback threw), except for std::bad_alloc, non-standard
+/// exceptions and InputErrors from beforeRename (which name their own file), rethrown as they
+/// are.
 void writeAtomically(const std::filesystem::path& file,
                      const std::function<void(const std::filesystem::path& temporary)>& write,
                      const std::function<void()>& beforeRename = {});

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -47,7 +48,10 @@ public:
 /// name in the same folder, then renamed: never half-written. Throws ImageError, also for an
 /// empty or repeated metadata key and for keys that OpenEXR/OIIO interpret themselves
 /// ("compression", "name", "owner", "DateTime", "oiio:*", ...), which would not come back.
-void writeExr(const Image& image, const std::filesystem::path& path, const Metadata& metadata);
+/// beforeRename, if given, runs once the EXR is written and synced, before it is renamed into
+/// place: what it writes (the previews) is in place first, and if it throws the EXR is not.
+void writeExr(const Image& image, const std::filesystem::path& path, const Metadata& metadata,
+              const std::function<void()>& beforeRename = {});
 
 /// 8-bit sRGB PNG preview of RGB (alpha composited over black, clamped), atomically.
 void writePng(const Image& image, const std::filesystem::path& path);

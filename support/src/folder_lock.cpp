@@ -1,0 +1,45 @@
+#include "pine/support/folder_lock.h"
+
+#include "pine/support/input_error.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace pine::io {
+
+namespace fs = std::filesystem;
+
+FolderLock::FolderLock(const fs::path& folder, const std::function<void()>& onWait)
+{
+    mFd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (mFd < 0) {
+        throw InputError("cannot write into '" + folder.string() + "': " + std::strerror(errno));
+    }
+    if (::flock(mFd, LOCK_EX | LOCK_NB) == 0) return;
+    if (errno == EWOULDBLOCK) {
+        if (onWait) onWait();
+        int locked;
+        while ((locked = ::flock(mFd, LOCK_EX)) != 0 && errno == EINTR) {
+        }
+        if (locked == 0) return;
+    }
+    const int why = errno;
+    ::close(mFd);
+    throw InputError("cannot lock '" + folder.string() + "': " + std::strerror(why));
+}
+
+FolderLock::~FolderLock()
+{
+    if (mFd >= 0) ::close(mFd);  // closing releases the lock
+}
+
+fs::path FolderLock::of(const fs::path& file)
+{
+    return file.has_parent_path() ? file.parent_path() : fs::path(".");
+}
+
+}  // namespace pine::io
