@@ -16,29 +16,50 @@ bool isLSystemSymbol(char c)
     return isTurtleSymbol(c) || std::isalpha(static_cast<unsigned char>(c));
 }
 
-std::size_t expandedLength(const std::string& axiom, const std::map<char, std::string>& rules,
-                           int iterations, std::size_t limit)
+namespace {
+
+// The count of symbols after `iterations` rewrites, where a symbol left as it is counts
+// base[c]; saturates at limit + 1. count_k(c) is the count symbol c grows to in k rewrites.
+std::size_t expandedTotal(const std::string& axiom, const std::map<char, std::string>& rules,
+                          int iterations, const std::size_t (&base)[256], std::size_t limit)
 {
-    // length_k(c): the length symbol c grows to in k rewrites; 256 entries per step.
-    std::size_t length[256];
-    for (std::size_t& n : length) n = 1;
+    std::size_t count[256];
+    for (int c = 0; c < 256; ++c) count[c] = base[c];
     const auto saturated = [limit](std::size_t a, std::size_t b) {
         // a + b, capped at limit + 1 (either may be capped already).
         return a > limit || b > limit || a > limit - b ? limit + 1 : a + b;
     };
     for (int k = 0; k < iterations; ++k) {
         std::size_t next[256];
-        for (int c = 0; c < 256; ++c) next[c] = length[c];
+        for (int c = 0; c < 256; ++c) next[c] = count[c];
         for (const auto& [symbol, successor] : rules) {
             std::size_t n = 0;
-            for (char s : successor) n = saturated(n, length[static_cast<unsigned char>(s)]);
+            for (char s : successor) n = saturated(n, count[static_cast<unsigned char>(s)]);
             next[static_cast<unsigned char>(symbol)] = n;
         }
-        for (int c = 0; c < 256; ++c) length[c] = next[c];
+        for (int c = 0; c < 256; ++c) count[c] = next[c];
     }
     std::size_t n = 0;
-    for (char s : axiom) n = saturated(n, length[static_cast<unsigned char>(s)]);
+    for (char s : axiom) n = saturated(n, count[static_cast<unsigned char>(s)]);
     return n;
+}
+
+}  // namespace
+
+std::size_t expandedLength(const std::string& axiom, const std::map<char, std::string>& rules,
+                           int iterations, std::size_t limit)
+{
+    std::size_t every[256];
+    for (std::size_t& n : every) n = 1;
+    return expandedTotal(axiom, rules, iterations, every, limit);
+}
+
+std::size_t expandedCount(const std::string& axiom, const std::map<char, std::string>& rules,
+                          int iterations, const std::string& counted, std::size_t limit)
+{
+    std::size_t base[256] = {};
+    for (char c : counted) base[static_cast<unsigned char>(c)] = 1;
+    return expandedTotal(axiom, rules, iterations, base, limit);
 }
 
 std::string expandLSystem(const std::string& axiom, const std::map<char, std::string>& rules,

@@ -59,6 +59,17 @@ void readLSystem(ObjectReader& r, Species& s)
         r.where().key("iterations").fail("the L-system grows past " +
                                          std::to_string(kMaxLSystemLength) + " symbols");
     }
+    const auto maxSegments = std::size_t(readInteger(
+        r.optional("max_segments") ? *r.optional("max_segments") : Json(kDefaultMaxSegments),
+        r.where().key("max_segments"), 1, (long long)kMaxLSystemLength));
+    if (const std::size_t segments =
+            expandedCount(s.axiom, s.rules, s.iterations, "F", maxSegments);
+        segments > maxSegments) {
+        r.where().key("iterations").fail(
+            "the L-system grows more than " + std::to_string(maxSegments) +
+            " segments (F), lsystem.max_segments; raise it knowingly: render time grows "
+            "faster than the segments where boughs crowd");
+    }
     s.branchAngle_rad =
         kRadPerDeg * r.number("branch_angle_deg", Range::closed(0, 180), s.branchAngle_rad /
                                                                              kRadPerDeg);

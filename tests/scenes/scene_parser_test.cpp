@@ -2,10 +2,12 @@
 // "FILE[:LINE:COL]: key.path: problem" (docs/scene-format.md, "Errors").
 #include "test_support.h"
 
+#include "pine/scenes/lsystem.h"
 #include "pine/scenes/scene.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <numbers>
@@ -498,6 +500,35 @@ TEST(SceneParser, RejectsBadLSystems)
     j["species"]["fir"]["lsystem"]["rules"]["A"] = "AA";
     j["species"]["fir"]["lsystem"]["iterations"] = 30;
     expectError(j, "species.fir.lsystem.iterations", "grows past");
+    // A bushy rule within those symbols: 2^17 - 1 segments, whose crowded boughs rendered for
+    // minutes. Refused before growing unless lsystem.max_segments allows it.
+    j = fullScene();
+    j["species"]["fir"]["lsystem"]["rules"] = {{"A", "F[&A][^A]"}};
+    j["species"]["fir"]["lsystem"]["axiom"] = "A";
+    j["species"]["fir"]["lsystem"]["iterations"] = 17;
+    expectError(j, "species.fir.lsystem.iterations", "more than 50000 segments (F)");
+    j["species"]["fir"]["lsystem"]["max_segments"] = 131070;
+    expectError(j, "species.fir.lsystem.iterations", "more than 131070 segments");
+    j["species"]["fir"]["lsystem"]["max_segments"] = 131071;
+    EXPECT_NO_THROW(parseScene(j.dump(), "test.json"));
+    j["species"]["fir"]["lsystem"]["max_segments"] = 0;
+    expectError(j, "species.fir.lsystem.max_segments", "must be in [1, 4000000]");
+}
+
+TEST(LSystem, ExpandedCountCountsWhatExpandingWouldHold)
+{
+    // Counted without building the string, checked against the string built.
+    const std::map<char, std::string> rules = {{'A', "F[+A]B"}, {'B', "FFB"}};
+    for (int iterations = 0; iterations <= 6; ++iterations) {
+        const std::string grown = expandLSystem("A", rules, iterations);
+        const auto count = [&](char c) {
+            return std::size_t(std::count(grown.begin(), grown.end(), c));
+        };
+        EXPECT_EQ(expandedCount("A", rules, iterations, "F", 1000000), count('F'));
+        EXPECT_EQ(expandedCount("A", rules, iterations, "[+", 1000000), count('[') + count('+'));
+        EXPECT_EQ(expandedLength("A", rules, iterations), grown.size());
+    }
+    EXPECT_EQ(expandedCount("A", rules, 30, "F", 100), 101u);  // saturated
 }
 
 TEST(SceneParser, RejectsNeedlesThatCannotExist)

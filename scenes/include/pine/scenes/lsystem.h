@@ -24,6 +24,17 @@ bool isLSystemSymbol(char c);
 std::size_t expandedLength(const std::string& axiom, const std::map<char, std::string>& rules,
                            int iterations, std::size_t limit = kMaxLSystemLength);
 
+/// Default of a species' lsystem.max_segments: the F symbols (segments, each a branch that may
+/// bear a bough) one tree may grow. A paper fir has about 350; render time grows faster than
+/// the segments where their boughs crowd one another (a bushy rule of 131,072 segments rendered
+/// for minutes), so a larger tree is asked for knowingly.
+inline constexpr std::size_t kDefaultMaxSegments = 50'000;
+
+/// How many symbols among `counted` the string holds after `iterations` rewrites, without
+/// building it; saturates at `limit` + 1.
+std::size_t expandedCount(const std::string& axiom, const std::map<char, std::string>& rules,
+                          int iterations, const std::string& counted, std::size_t limit);
+
 /// The string after `iterations` parallel rewrites of `axiom` (a symbol without a rule is
 /// copied). Throws std::length_error past `limit` symbols.
 std::string expandLSystem(const std::string& axiom, const std::map<char, std::string>& rules,
