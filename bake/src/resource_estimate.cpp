@@ -158,6 +158,22 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
     return e;
 }
 
+ResourceEstimate estimateCompare(const scenes::Scene& scene, double smallestVoxel_cm,
+                                 std::size_t images)
+{
+    ResourceEstimate largest;
+    for (const char* method : {"multiscale", "reference", "geometry"}) {
+        ResourceEstimate e = estimateRender(scene, method, smallestVoxel_cm);
+        if (e.bytes() > largest.bytes()) largest = std::move(e);
+    }
+    const double pixels = double(scene.camera.width) * double(scene.camera.height);
+    if (images > 1) {
+        largest.parts.push_back({count(double(images - 1)) + " more images kept for the report",
+                                 double(images - 1) * pixels * kBytesPerPixel});
+    }
+    return largest;
+}
+
 ResourceEstimate estimateBake(const scenes::Scene& scene, const std::vector<std::size_t>& trees,
                               double voxelSize_cm, std::size_t concurrent)
 {

@@ -1,9 +1,11 @@
 #include "pine/vdbtrace/compare.h"
 
+#include "pine/bake/resource_estimate.h"
 #include "pine/support/atomic_file.h"
 #include "pine/vdbtrace/compare_report.h"
 #include "pine/vdbtrace/dolly.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -13,7 +15,10 @@ bool parseResolution(const std::string& text, int& width, int& height)
 {
     int w = 0, h = 0, used = 0;
     if (std::sscanf(text.c_str(), "%dx%d%n", &w, &h, &used) != 2) return false;
-    if (std::size_t(used) != text.size() || w < 1 || h < 1) return false;
+    constexpr int kMaxSide = 16384;  // a scene's camera.resolution allows no more
+    if (std::size_t(used) != text.size() || w < 1 || h < 1 || w > kMaxSide || h > kMaxSide) {
+        return false;
+    }
     width = w;
     height = h;
     return true;
@@ -38,6 +43,16 @@ CompareRun runCompare(const CompareOptions& options)
     log(options.sceneFile.string() + ", " + std::to_string(scene.camera.width) + "x" +
         std::to_string(scene.camera.height));
     const CompareSettings& st = options.settings;
+    if (options.maxMemoryBytes > 0.0) {
+        const std::size_t images = 1 + st.geometrySamples.size() + st.voxelSizes_cm.size() +
+                                   st.levels.size();
+        const double smallest =
+            st.voxelSizes_cm.empty()
+                ? 1.0
+                : *std::min_element(st.voxelSizes_cm.begin(), st.voxelSizes_cm.end());
+        bake::checkMemory(bake::estimateCompare(scene, smallest, images), options.maxMemoryBytes,
+                          options.sceneFile.string());
+    }
     CompareRun run = runComparison(scene, st, log);
 
     ReportInfo info;

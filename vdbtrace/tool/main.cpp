@@ -463,10 +463,17 @@ int main(int argc, char** argv)
     compareCmd->add_option("--resolution", resolution, "WxH instead of the camera's (same view)")
         ->check([](const std::string& text) {
             int w = 0, h = 0;
-            return vdbtrace::parseResolution(text, w, h) ? std::string()
-                                                          : "expected WxH, e.g. 64x48";
+            return vdbtrace::parseResolution(text, w, h)
+                       ? std::string()
+                       : "expected WxH, each at most 16384, e.g. 64x48";
         });
     compareCmd->add_flag("--no-plot", noPlot, "Skip error_vs_time.png (matplotlib)");
+    compareCmd
+        ->add_option("--max-memory", maxMemoryGiB,
+                     "Refuse, before any work, a comparison estimated to need more memory "
+                     "than this, in GiB (default: 80% of this machine's, " +
+                         bake::formatBytes(bake::defaultMemoryLimit()) + ")")
+        ->check(tool::positiveNumber());
     model.add(*compareCmd);
 
     return tool::run("vdbtrace", app, argc, argv, [&] {
@@ -477,6 +484,7 @@ int main(int argc, char** argv)
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
         if (*compareCmd) {
             compare.settings = vdbtrace::CompareSettings::forQuick(quick);
+            compare.maxMemoryBytes = bake::memoryLimit(maxMemoryGiB);
             compare.machine = machineDescription();
             compare.model = [&model](scenes::ModelChoices& m) { model.apply(m); };
             compare.log = [](const std::string& line) {

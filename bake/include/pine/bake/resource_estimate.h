@@ -38,6 +38,11 @@ TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size
 ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
                                 double voxelSize_cm, double voxelsRead = 0.0);
 
+/// The memory `vdbtrace compare` will need: the largest of its methods' renders (the reference
+/// at `smallestVoxel_cm`), with `images` renders kept at once for the report.
+ResourceEstimate estimateCompare(const scenes::Scene& scene, double smallestVoxel_cm,
+                                 std::size_t images);
+
 /// The memory a bake of `trees` (indices into scene.trees) at `voxelSize_cm` will need, with
 /// up to `concurrent` trees in memory at once (each written before the next).
 ResourceEstimate estimateBake(const scenes::Scene& scene, const std::vector<std::size_t>& trees,

@@ -17,6 +17,7 @@ struct CompareOptions {
     /// Adjusts the scene's model choices after it is read (the command line's overrides).
     std::function<void(scenes::ModelChoices&)> model;
     int width = 0, height = 0;  ///< override of the camera's resolution (0: the scene's)
+    double maxMemoryBytes = 0.0;  ///< refuse, before any work, a run estimated to need more
     bool flicker = true;        ///< render the dolly (flicker.csv)
     std::string machine = "unknown machine";  ///< for the report: CPU, cores, threads
     CompareLog log;             ///< progress lines for a person; the last one sums up
@@ -29,7 +30,7 @@ struct CompareOptions {
 /// if `outDir` cannot be written (before any work), and what loading and rendering throw.
 CompareRun runCompare(const CompareOptions& options);
 
-/// "WxH" -> width, height (both >= 1); false if malformed.
+/// "WxH" -> width, height (both in [1, 16384], as a scene's camera); false if malformed.
 bool parseResolution(const std::string& text, int& width, int& height);
 
 }  // namespace pine::vdbtrace
