@@ -40,8 +40,6 @@ CompareRun runCompare(const CompareOptions& options)
         scene.camera.width = options.width;
         scene.camera.height = options.height;
     }
-    log(options.sceneFile.string() + ", " + std::to_string(scene.camera.width) + "x" +
-        std::to_string(scene.camera.height));
     const CompareSettings& st = options.settings;
     if (options.maxMemoryBytes > 0.0) {
         const std::size_t images = 1 + st.geometrySamples.size() + st.voxelSizes_cm.size() +
@@ -53,6 +51,8 @@ CompareRun runCompare(const CompareOptions& options)
         bake::checkMemory(bake::estimateCompare(scene, smallest, images), options.maxMemoryBytes,
                           options.sceneFile.string());
     }
+    log(options.sceneFile.string() + ", " + std::to_string(scene.camera.width) + "x" +
+        std::to_string(scene.camera.height));
     CompareRun run = runComparison(scene, st, log);
 
     ReportInfo info;
