@@ -36,7 +36,7 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         if (e.get_exit_code() == 0) return app.exit(e);  // --help
-        std::cerr << name << ": " << e.what() << " (see --help)\n";  // one line
+        std::cerr << name << ": " << oneLine(e.what()) << " (see --help)\n";
         return 2;
     }
     std::unique_ptr<tbb::global_control> limit;

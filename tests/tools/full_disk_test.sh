@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # A full disk, as a small tmpfs: every tool exits 2 with one line, leaves the previous file as
 # it was and no temporary behind. Needs root (mount); skipped (77) where it cannot mount.
-# Usage: full_disk_test.sh VDBTRACE BAKE SOURCE_DIR
+# Usage: full_disk_test.sh VDBTRACE BAKE SOURCE_DIR ANALYTIC
 set -u
 vdbtrace=$1
 bake=$2
 src=$3
+analytic=$4
 tool=$vdbtrace
 # shellcheck source=cli_test_lib.sh
 source "$(dirname "$0")/cli_test_lib.sh"
@@ -60,6 +61,15 @@ expect_error "bake onto a full disk" 2 "t.vdb" -- tree "$scene" --tree 0 --voxel
 [ "$(cat "$disk/t.vdb")" = old ] && [ "$(cat "$disk/t.vdb.json")" = '{}' ] \
     || fail "a failed bake replaced the previous pair"
 [ -z "$(leftovers)" ] || fail "temporaries left: $(leftovers)"
+
+# analytic sweep: its tables onto a disk with room for none of them (exit 2, not 1).
+tool=$analytic
+mount_disk 4k
+"$analytic" sweep --out "$disk/sweep" --cone-cases 50 --no-plot >"$work/out" 2>"$work/err"
+[ $? -eq 2 ] || fail "sweep onto a full disk: exit status is not 2"
+# (found after a stage of the sweep: its progress lines come first, the error last)
+tail -1 "$work/err" | grep -q "f_fit.csv': No space left" || fail "sweep onto a full disk: $(tail -1 "$work/err")"
+[ -z "$(find "$disk" -name '*.tmp-*')" ] || fail "sweep left temporaries: $(find "$disk" -name '*.tmp-*')"
 
 echo "full disk: $failures failed"
 [ "$failures" -eq 0 ]

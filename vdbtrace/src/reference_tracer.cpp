@@ -146,8 +146,12 @@ public:
     void march(Thread& thread, const Vec3& o, const Vec3& d, double tMax, Visit&& visit) const
     {
         if (!mHasVolume) return;
+        // OpenVDB's rays start after t = 0 (Ray::setTimes asserts t0 > 0, which a debug build
+        // checks): the 1e-9 cm skipped is far below any voxel.
+        const double tStart = openvdb::math::Delta<double>::value();
+        if (!(tMax > tStart)) return;
         using RayT = openvdb::math::Ray<double>;
-        const RayT ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), 0.0, tMax);
+        const RayT ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), tStart, tMax);
         Intersector& intersector = *thread.intersector;
         if (!intersector.setWorldRay(ray)) return;
         double i0, i1;
