@@ -11,7 +11,9 @@
 
 #include <openvdb/io/Stream.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <optional>
@@ -182,9 +184,9 @@ TreeGrids parseTreeGrids(const std::string& bytes, const fs::path& path)
         openvdb::io::Stream stream(in, /*delayLoad=*/false);
         grids = stream.getGrids();
         meta = stream.getMetadata();
-    } catch (const openvdb::Exception& e) {
-        throw BakeError("cannot read '" + path.string() + "': " + e.what());
-    } catch (const std::exception& e) {
+    } catch (const std::bad_alloc&) {
+        throw;  // the memory limit's answer, not the file's words
+    } catch (const std::exception& e) {  // openvdb::Exception among them
         throw BakeError("cannot read '" + path.string() + "': " + e.what());
     }
     if (!grids) throw BakeError("cannot read '" + path.string() + "': no grids");
@@ -233,8 +235,13 @@ TreeGrids readTreeGrids(const fs::path& path, double maxMemoryBytes)
     // A matching manifest says the bytes are those someone wrote, not that OpenVDB survives
     // them (a file edited or produced elsewhere comes with one), so they are parsed first in a
     // child process, its memory limited, where a crash or a runaway allocation is an answer.
-    const io::IsolationLimits limits{maxMemoryBytes > 0.0 ? maxMemoryBytes : defaultMemoryLimit(),
-                                     60.0 + double(bytes.size()) / 1e7};
+    // What a sound file needs: its nodes grow to some hundred times their compressed size
+    // (a 32^3 internal node is 400 KB in memory, a few KB on disk); damaged counts ask for
+    // gigabytes, or loop for minutes, on a file of kilobytes.
+    const double size = double(bytes.size());
+    const double limit = maxMemoryBytes > 0.0 ? maxMemoryBytes : defaultMemoryLimit();
+    const io::IsolationLimits limits{std::min(limit, 1024.0 * 1024 * 1024 + 256.0 * size),
+                                     std::round(10.0 + size / 2e6)};
     io::IsolatedOutcome trial;
     try {
         trial = io::runIsolated([&] { (void)parseTreeGrids(bytes, path); }, limits);

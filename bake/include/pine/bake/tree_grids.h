@@ -126,8 +126,9 @@ void writeTreeGrids(const TreeGrids& grids, const std::filesystem::path& path,
 /// a damaged or foreign file is refused with BakeError, never opened by OpenVDB. Refuses a file
 /// of another format version or of an extinction law not registered here. Also catches what
 /// OpenVDB throws. A file whose manifest matches (edited or produced elsewhere) is parsed first
-/// in a child process with at most `maxMemoryBytes` (0: defaultMemoryLimit()): where OpenVDB
-/// crashes, hangs or runs out of memory on it, BakeError says so. Call it before parallel work.
+/// in a child process with at most `maxMemoryBytes` (0: defaultMemoryLimit()), 1 GiB plus 256
+/// times the file's size and 10 s plus 1 s per 2 MB: where OpenVDB crashes, hangs or runs out of
+/// memory on it, BakeError says so. Call it before parallel work.
 TreeGrids readTreeGrids(const std::filesystem::path& path, double maxMemoryBytes = 0.0);
 
 }  // namespace pine::bake
