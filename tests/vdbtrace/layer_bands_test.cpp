@@ -52,6 +52,32 @@ TEST(LayerBands, WholeLayersStopALineAsEvenlySpacedNeedlesDo)
     }
 }
 
+TEST(LayerBands, AMillionLayersInOneSpanCostOneStep)
+{
+    // A layer spacing of 1e-6 cm puts a million layers in a voxel: the whole ones are taken at
+    // once, as (1 - n)^K, and agree with a span cut layer by layer where that is affordable.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int trial = 0; trial < 200; ++trial) {
+        const double n = 1e-4 + 0.01 * u(rng), start = u(rng), layers = 2.0 + 300.0 * u(rng);
+        LayerBands whole, cut;
+        whole.span(n * start, start);  // a band begun before
+        cut.span(n * start, start);
+        const double T = whole.span(n * layers, layers);
+        double byLayer = 1.0;
+        for (double done = 0.0; done < layers;) {
+            const double step = std::min(0.37, layers - done);
+            byLayer *= cut.span(n * step, step);
+            done += step;
+        }
+        EXPECT_NEAR(T, byLayer, 1e-12) << trial;
+        // and the band they leave begun goes on alike
+        EXPECT_NEAR(whole.span(n * 0.5, 0.5), cut.span(n * 0.5, 0.5), 1e-12) << trial;
+    }
+    LayerBands bands;
+    EXPECT_NEAR(bands.span(1e6 * 1e-7, 1e6), std::pow(1.0 - 1e-7, 1e6), 1e-12);
+}
+
 TEST(LayerBands, ABandEndsWhereTheLineTurnsBackOrLeavesTheMedium)
 {
     std::mt19937 rng(5);

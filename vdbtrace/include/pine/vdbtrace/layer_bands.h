@@ -36,12 +36,24 @@ public:
             mCrossed = 1.0;  // the line turned back through the layers: a new band
         }
         double left = crossings, T = 1.0;
-        while (left > 0.0 && T > 0.0) {
-            if (mCrossed >= 1.0) begin();
+        if (mCrossed < 1.0) {  // the band begun before this span, finished first
             const double step = std::min(left, 1.0 - mCrossed);
             T *= stretch(needles * (step / crossings));  // no overflow for tiny crossings
             mCrossed += step;
             left -= step;
+        }
+        if (left >= 1.0) {
+            // Whole bands, each met from its start by needles / crossings needles: at once, as
+            // a layer spacing of 1e-6 cm puts a million in one voxel.
+            const double whole = std::floor(left);
+            T *= std::pow(1.0 - std::min(1.0, needles / crossings), whole);
+            mCrossed = 1.0;
+            left -= whole;
+        }
+        if (left > 0.0) {  // the band this span leaves begun
+            begin();
+            T *= stretch(needles * (left / crossings));
+            mCrossed = left;
         }
         return T;
     }
