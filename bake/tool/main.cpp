@@ -158,7 +158,8 @@ int verify(const std::vector<fs::path>& paths, double maxMemoryGiB)
     int refused = 0;
     for (const fs::path& file : files) {
         try {
-            const bake::TreeGrids grids = bake::readTreeGrids(file, bake::memoryLimit(maxMemoryGiB));
+            const bake::TreeGrids grids =
+                bake::readTreeGrids(file, bake::memoryLimit(maxMemoryGiB));
             std::cout << file.string() << ": ok, " << grids.density->activeVoxelCount()
                       << " voxels of " << grids.voxelSize_cm << " cm, extinction law "
                       << grids.extinctionLaw << "\n";

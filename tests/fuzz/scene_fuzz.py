@@ -196,7 +196,7 @@ def check(name, argv, out):
     timings.append((time.monotonic() - start, name, argv[1], status,
                     err.strip().split("\n")[-1][-150:]))
     lines = [line for line in err.replace("\r", "\n").splitlines() if line.strip()]
-    what = f"{name}: {' '.join(os.path.basename(a) if i == 0 else a for i, a in enumerate(argv[:2]))}"
+    what = f"{name}: {os.path.basename(argv[0])} {argv[1]}"
     if status == 0:
         if out.endswith(".exr"):
             ok, why = finite_pixels(out)

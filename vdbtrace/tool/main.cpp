@@ -379,6 +379,16 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
     return 0;
 }
 
+/// --max-memory (GiB) on `cmd`, for `task` ("a render").
+void addMaxMemory(CLI::App& cmd, double& gib, const std::string& task)
+{
+    cmd.add_option("--max-memory", gib,
+                   "Refuse, before any work, " + task + " estimated to need more memory than "
+                   "this, in GiB (default: 80% of this machine's, " +
+                       bake::formatBytes(bake::defaultMemoryLimit()) + ")")
+        ->check(tool::positiveNumber());
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -414,12 +424,7 @@ int main(int argc, char** argv)
     renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")
         ->required();
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
-    renderCmd
-        ->add_option("--max-memory", maxMemoryGiB,
-                     "Refuse, before any work, a render estimated to need more memory than "
-                     "this, in GiB (default: 80% of this machine's, " +
-                         bake::formatBytes(bake::defaultMemoryLimit()) + ")")
-        ->check(tool::positiveNumber());
+    addMaxMemory(*renderCmd, maxMemoryGiB, "a render");
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
         ->check(CLI::IsMember({"level"}));
     ModelOverrides model;
@@ -468,12 +473,7 @@ int main(int argc, char** argv)
                        : "expected WxH, each at most 16384, e.g. 64x48";
         });
     compareCmd->add_flag("--no-plot", noPlot, "Skip error_vs_time.png (matplotlib)");
-    compareCmd
-        ->add_option("--max-memory", maxMemoryGiB,
-                     "Refuse, before any work, a comparison estimated to need more memory "
-                     "than this, in GiB (default: 80% of this machine's, " +
-                         bake::formatBytes(bake::defaultMemoryLimit()) + ")")
-        ->check(tool::positiveNumber());
+    addMaxMemory(*compareCmd, maxMemoryGiB, "a comparison");
     model.add(*compareCmd);
 
     return tool::run("vdbtrace", app, argc, argv, [&] {
