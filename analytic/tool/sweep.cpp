@@ -2,6 +2,7 @@
 
 #include "pine/support/atomic_file.h"
 #include "pine/support/plot_script.h"
+#include "pine/support/progress.h"
 
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/cone_shader.h"
@@ -78,6 +79,7 @@ nlohmann::json sweepConeFits(const fs::path& dir, const SweepOptions& opt)
         c.V = randomDirection();
     }
     std::atomic<int> done{0};
+    pine::tool::Progress progress("analytic sweep:");
     tbb::parallel_for(std::size_t(0), cases.size(), [&](std::size_t i) {
         ConeCase& c = cases[i];
         c.ours = coneIntegrals(c.phi, c.axis, c.L, c.V, c.n);
@@ -87,10 +89,9 @@ nlohmann::json sweepConeFits(const fs::path& dir, const SweepOptions& opt)
         c.lambdaFit = coneDiffuseLambdaFit(c.phi, c.axis, c.L, c.V, true);
         c.lambdaRef = reference::coneLambdaFitIntegral(c.phi, c.axis, c.L, c.V, true);
         c.printedS = coneSpecularPrinted(c.phi, c.axis, c.L, c.V, c.n, true);
-        const int k = ++done;
-        if (k % 200 == 0) std::cerr << "\r  cone fits: " << k << "/" << cases.size() << std::flush;
+        progress.count(std::size_t(++done), cases.size(), "cone fits");
     });
-    std::cerr << '\n';
+    progress.finish();
 
     std::ostringstream csv;
     csv << "phi,phi_V,phi_L,exponent,J_ref,J_ours,J_printed,G_ref,G_ours,P_ref,P_lambda_fit,"

@@ -6,6 +6,7 @@
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/support/atomic_file.h"
+#include "pine/support/progress.h"
 #include "pine/support/tool_main.h"
 
 #include <CLI/CLI.hpp>
@@ -19,16 +20,12 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
-#include <mutex>
 #include <vector>
 
 namespace {
 
 using namespace pine;
 namespace fs = std::filesystem;
-
-/// Set once a progress line is on stderr without its newline: an error then starts a new line.
-std::atomic<bool> gProgressOpen{false};
 
 struct Totals {
     std::atomic<std::size_t> trees{0};
@@ -113,16 +110,13 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
         io::checkOutputsApart({treeFile(dir, i), treeFile(dir, i).string() + ".json"}, {sceneFile});
     }
     Totals totals;
-    std::mutex progress;
+    tool::Progress progress("bake:");
     // Trees in parallel, one task each; bakeBoughs also splits a tree's boughs among threads.
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
         bakeTree(scene, sceneFile, i, settings, treeFile(dir, i), totals);
-        const std::lock_guard<std::mutex> lock(progress);
-        std::fprintf(stderr, "\rbake: %zu/%zu trees", totals.trees.load(), n);
-        std::fflush(stderr);
-        gProgressOpen = true;
+        progress.count(totals.trees.load(), n, "trees");
     });
-    if (gProgressOpen.exchange(false)) std::fputc('\n', stderr);
+    progress.finish();
     summarize(totals, start);
     return 0;
 }
@@ -225,13 +219,8 @@ int main(int argc, char** argv)
         ->check(positive);
 
     return tool::run("bake", app, argc, argv, [&] {
-        try {
-            if (*treeCmd) return bakeOne(sceneFile, tree, settings, law, out, maxMemoryGiB);
-            if (*verifyCmd) return verify(verifyPaths, maxMemoryGiB);
-            return bakeScene(sceneFile, settings, law, outDir, maxMemoryGiB);
-        } catch (...) {
-            if (gProgressOpen.exchange(false)) std::fputc('\n', stderr);  // the error's own line
-            throw;
-        }
+        if (*treeCmd) return bakeOne(sceneFile, tree, settings, law, out, maxMemoryGiB);
+        if (*verifyCmd) return verify(verifyPaths, maxMemoryGiB);
+        return bakeScene(sceneFile, settings, law, outDir, maxMemoryGiB);
     });
 }

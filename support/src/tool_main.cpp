@@ -1,6 +1,7 @@
 #include "pine/support/tool_main.h"
 
 #include "pine/support/input_error.h"
+#include "pine/support/progress.h"
 
 #include <sys/resource.h>
 #include <tbb/global_control.h>
@@ -32,6 +33,10 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
     int threads = 0;
     app.add_option("--threads", threads, "Worker threads (default: all cores)")
         ->check(CLI::NonNegativeNumber);
+    app.set_version_flag("--version", std::string(name) + " " + PINE_TOOL_VERSION);
+    for (CLI::App* sub : app.get_subcommands({})) {
+        sub->fallthrough();  // --threads and --version also after the subcommand
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -47,14 +52,17 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
     try {
         return body();
     } catch (const InputError& e) {
+        Progress::endOpenLine();
         std::cerr << name << ": " << oneLine(e.what()) << '\n';
         return 2;
     } catch (const std::bad_alloc&) {
+        Progress::endOpenLine();
         std::cerr << name << ": out of memory: the scene or the settings ask for more than this "
                              "machine has (lower the resolution, the samples, the trees or the "
                              "voxel size)\n";
         return 2;
     } catch (const std::exception& e) {
+        Progress::endOpenLine();
         std::cerr << name << ": " << oneLine(e.what()) << '\n';
         return 1;
     }

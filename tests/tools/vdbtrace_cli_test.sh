@@ -14,6 +14,19 @@ expect_error "malformed scene" 2 "broken.json:1:" -- render "$work/broken.json" 
 expect_error "unwritable output" 2 "no/such/dir" -- render "$src/scenes/bough.json" --out "$work/no/such/dir/a.exr"
 expect_error "unknown method" 2 "not available" -- render "$src/scenes/bough.json" --method nonsense --out "$work/a.exr"
 expect_error "bad option" 2 "force-level" -- render "$src/scenes/bough.json" --out "$work/a.exr" --force-level 7
+expect_error "another method's option" 2 "samples applies to --method geometry, not multiscale" -- render "$src/scenes/bough.json" --out "$work/a.exr" --samples 4
+expect_error "another method's option" 2 "voxel-size applies to --method reference, not geometry" -- render "$src/scenes/bough.json" --method geometry --out "$work/a.exr" --voxel-size 1
+[ "$("$vdbtrace" --version)" = "vdbtrace $(sed -n 's/^project(PineMultiscale VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt")" ] \
+    || fail "--version: $("$vdbtrace" --version)"
+# --threads after the subcommand too; progress as plain lines, in order, when stderr is a file.
+"$vdbtrace" render "$src/scenes/bough.json" --out "$work/p.exr" --threads 1 2>"$work/err" \
+    || fail "render with --threads after the subcommand: $(tail -1 "$work/err")"
+! grep -q $'\r' "$work/err" || fail "progress with carriage returns into a file"
+grep "rendering" "$work/err" | awk '{ sub("%", "", $3); if ($3 + 0 < last) bad = 1; last = $3 + 0 } END { exit bad }' \
+    || fail "progress out of order: $(grep rendering "$work/err" | tr '\n' ' ')"
+[ "$(grep -c rendering "$work/err")" -le 11 ] || fail "more than 11 progress lines in a file"
+grep -q "1 tree, 3 branches, 271 needles" "$work/err" || fail "counts: $(head -1 "$work/err")"
+rm -f "$work/p.exr" "$work/p.png"
 # Outputs that would destroy an input, each other or a device, and formats the name does not
 # say: refused before any work, the files left as they were.
 cp "$src/scenes/bough.json" "$work/scene.json"

@@ -7,6 +7,7 @@
 #include "pine/support/atomic_file.h"
 #include "pine/support/folder_lock.h"
 #include "pine/support/plot_script.h"
+#include "pine/support/progress.h"
 #include "pine/support/tool_main.h"
 #include "pine/vdbtrace/compare.h"
 #include "pine/vdbtrace/geometry_tracer.h"
@@ -43,13 +44,11 @@ namespace {
 using namespace pine;
 namespace fs = std::filesystem;
 
-vdbtrace::RenderOptions withProgress(const std::string& what)
+/// Options whose progress `shown` reports.
+vdbtrace::RenderOptions withProgress(tool::Progress& shown)
 {
     vdbtrace::RenderOptions options;
-    options.progress = [what](double fraction) {
-        std::fprintf(stderr, "\rvdbtrace: %s %3d%%", what.c_str(), int(fraction * 100.0 + 0.5));
-        std::fflush(stderr);
-    };
+    options.progress = [&shown](double fraction) { shown.update(fraction); };
     return options;
 }
 
@@ -119,9 +118,14 @@ std::string describe(const scenes::Scene& scene, const vdbtrace::TracedScene& tr
         needles += tree.counts().needles;
         branches += double(tree.counts().branches);
     }
-    std::ostringstream s;
-    s << scene.trees.size() << " trees, " << branches << " branches, " << needles << " needles";
-    return s.str();
+    // Needle counts are expected values (cones times needles per cone, which may vary along a
+    // bough): shown whole, as counts.
+    const auto counted = [](double n, const char* one, const char* many) {
+        const auto whole = static_cast<long long>(std::llround(n));
+        return std::to_string(whole) + " " + (whole == 1 ? one : many);
+    };
+    return counted(double(scene.trees.size()), "tree", "trees") + ", " +
+           counted(branches, "branch", "branches") + ", " + counted(needles, "needle", "needles");
 }
 
 fs::path besideWith(const fs::path& image, const std::string& suffix)
@@ -184,9 +188,10 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     if (methodName == "reference" && !baked) {
         std::cerr << "vdbtrace: baking the boughs at " << settings.voxelSize_cm << " cm\n";
     }
+    tool::Progress rendering("vdbtrace: rendering");
     const vdbtrace::RenderResult result =
-        method.render(loaded->traced, settings, withProgress("rendering"));
-    std::cerr << '\n';
+        method.render(loaded->traced, settings, withProgress(rendering));
+    rendering.finish();
 
     const auto& s = loaded->scene;
     const nlohmann::json effects = vdbtrace::toJson(vdbtrace::EffectsPlan::from(s.effects));
@@ -256,9 +261,8 @@ vdbtrace::RenderResult timed(const scenes::Scene& scene, const std::string& labe
         *buildSeconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
-    vdbtrace::RenderResult r = vdbtrace::renderMultiscale(traced, {}, withProgress(label));
-    std::cerr << '\n';
-    return r;
+    tool::Progress shown("vdbtrace: " + label);
+    return vdbtrace::renderMultiscale(traced, {}, withProgress(shown));
 }
 
 int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model)
@@ -379,6 +383,11 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
     return 0;
 }
 
+/// The render options that belong to one method.
+constexpr std::pair<const char*, const char*> kMethodOptions[] = {
+    {"--voxel-size", "reference"}, {"--grids", "reference"},    {"--subpixels", "reference"},
+    {"--samples", "geometry"},     {"--force-level", "multiscale"}};
+
 /// --max-memory (GiB) on `cmd`, for `task` ("a render").
 void addMaxMemory(CLI::App& cmd, double& gib, const std::string& task)
 {
@@ -478,6 +487,14 @@ int main(int argc, char** argv)
 
     return tool::run("vdbtrace", app, argc, argv, [&] {
         if (*renderCmd) {
+            // An option of another method would be ignored: refused, so that no one believes
+            // a multiscale render took 4 samples.
+            for (const auto& [option, owner] : kMethodOptions) {
+                if (renderCmd->count(option) && method != owner) {
+                    throw InputError(std::string(option) + " applies to --method " + owner +
+                                     ", not " + method);
+                }
+            }
             return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles, model,
                           maxMemoryGiB);
         }
