@@ -415,20 +415,23 @@ int main(int argc, char** argv)
     for (const vdbtrace::RenderMethod& m : vdbtrace::renderMethods()) {
         methods += (methods.empty() ? "" : "; ") + std::string(m.name) + ": " + m.description;
     }
-    renderCmd->add_option("--method", method, methods);
+    renderCmd->add_option("--method", method, methods)->capture_default_str();
     vdbtrace::MethodSettings settings;
     std::vector<fs::path> gridFiles;
     renderCmd->add_option("--voxel-size", settings.voxelSize_cm,
                           "reference: voxel size of the baked boughs, cm")
+        ->capture_default_str()
         ->check(CLI::PositiveNumber);
     renderCmd->add_option("--grids", gridFiles,
                           "reference: baked .vdb files (bake tree/scene) instead of baking now")
         ->check(CLI::ExistingFile);
     renderCmd->add_option("--subpixels", settings.reference.subpixels,
                           "reference: rays per pixel along each axis (the cone's footprint)")
+        ->capture_default_str()
         ->check(CLI::Range(1, 16));
     renderCmd->add_option("--samples", settings.geometry.samples,
                           "geometry: point samples per pixel")
+        ->capture_default_str()
         ->check(CLI::Range(1, 65536));
     renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")
         ->required();
