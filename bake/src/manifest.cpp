@@ -65,7 +65,11 @@ struct Recorded {
 };
 Recorded recorded(const nlohmann::json& j)
 {
-    return {j.at("bytes").get<std::uintmax_t>(), j.at("fnv1a64").get<std::string>()};
+    const nlohmann::json& bytes = j.at("bytes");
+    if (!bytes.is_number_unsigned()) {  // a double cast to an integer is undefined behaviour
+        throw nlohmann::json::type_error::create(302, "bytes must be a whole number", &bytes);
+    }
+    return {bytes.get<std::uintmax_t>(), j.at("fnv1a64").get<std::string>()};
 }
 
 }  // namespace

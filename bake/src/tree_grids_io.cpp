@@ -10,6 +10,7 @@
 #include "pine/support/isolated_process.h"
 
 #include <openvdb/io/Stream.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -141,35 +142,39 @@ void writeTreeGrids(const TreeGrids& grids, const fs::path& path,
 
     // Runs writing into this folder take turns: each grid and manifest pair then comes from
     // one run, and the stale temporaries removed here are a killed run's, not a live one's.
-    std::optional<io::FolderLock> turn;
-    asBakeError([&] { turn.emplace(io::FolderLock::of(path)); });
-    io::removeStaleTemporaries(path);
-    io::removeStaleTemporaries(detail::manifestPath(path));
-    // Written under a temporary name beside the target, synced, then renamed: a crash or an
-    // error never leaves a half-written file under the final name (DESIGN.md). The manifest
-    // goes in first, accepting both the new grid and the one it replaces, so that a kill
-    // between the renames leaves a matching pair; then it is written again for the new grid
-    // alone.
-    const std::optional<detail::FileDigest> replaced = detail::acceptedDigest(path);
-    detail::FileDigest digest;
-    asBakeError([&] {
-        io::writeAtomically(
-            path,
-            [&](const fs::path& tmp) {
-                openvdb::io::File file(tmp.string());
-                file.write(list, meta);  // openvdb::Exception derives from std::exception
-                file.close();
-                digest = detail::digestFile(tmp);
-            },
-            [&] { detail::writeManifest(path, digest, replaced); });
-    });
-    if (replaced) {
-        // A failure here leaves a manifest that still matches the new grid: not an error.
-        try {
-            detail::writeManifest(path, digest);
-        } catch (const BakeError&) {
+    // Isolated: OpenVDB's write runs parallel statistics, and a thread waiting on them must not
+    // take up another tree of a caller's parallel loop, which would wait for this lock.
+    tbb::this_task_arena::isolate([&] {
+        std::optional<io::FolderLock> turn;
+        asBakeError([&] { turn.emplace(io::FolderLock::of(path)); });
+        io::removeStaleTemporaries(path);
+        io::removeStaleTemporaries(detail::manifestPath(path));
+        // Written under a temporary name beside the target, synced, then renamed: a crash or an
+        // error never leaves a half-written file under the final name (DESIGN.md). The manifest
+        // goes in first, accepting both the new grid and the one it replaces, so that a kill
+        // between the renames leaves a matching pair; then it is written again for the new grid
+        // alone.
+        const std::optional<detail::FileDigest> replaced = detail::acceptedDigest(path);
+        detail::FileDigest digest;
+        asBakeError([&] {
+            io::writeAtomically(
+                path,
+                [&](const fs::path& tmp) {
+                    openvdb::io::File file(tmp.string());
+                    file.write(list, meta);  // openvdb::Exception derives from std::exception
+                    file.close();
+                    digest = detail::digestFile(tmp);
+                },
+                [&] { detail::writeManifest(path, digest, replaced); });
+        });
+        if (replaced) {
+            // A failure here leaves a manifest that still matches the new grid: not an error.
+            try {
+                detail::writeManifest(path, digest);
+            } catch (const BakeError&) {
+            }
         }
-    }
+    });
 }
 
 namespace {

@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -97,6 +99,11 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
     }
     ::close(fd);
     if (beforeRename) step(beforeRename, true);
+    // Fault injection (tests/fuzz/kill_test.py): a kill at the one moment random kills miss.
+    if (const char* name = std::getenv("PINE_KILL_BEFORE_RENAME");
+        name && file.filename() == name) {
+        ::raise(SIGKILL);
+    }
     std::error_code error;
     fs::rename(tmp, file, error);
     if (error) throw refuse(error.message());

@@ -20,6 +20,13 @@ FolderLock::FolderLock(const fs::path& folder, const std::function<void()>& onWa
         throw InputError("cannot write into '" + folder.string() + "': " + std::strerror(errno));
     }
     if (::flock(mFd, LOCK_EX | LOCK_NB) == 0) return;
+    if (errno == EBADF || errno == ENOLCK || errno == EOPNOTSUPP || errno == EINVAL) {
+        // A file system that cannot lock a folder (NFS emulates flock with byte-range locks,
+        // which a folder opened for reading cannot take): written unlocked, as before locks.
+        ::close(mFd);
+        mFd = -1;
+        return;
+    }
     if (errno == EWOULDBLOCK) {
         if (onWait) onWait();
         int locked;

@@ -55,7 +55,9 @@ void writeAll(int fd, const std::string& text)
     }
 }
 
-enum ChildStatus { kReturned = 0, kThrew = 1, kOutOfMemory = 3 };
+// The child's reply: one byte saying how the step ended, then its words. An exit without the
+// byte (a library calling exit(0), a sanitizer's report) is a crash.
+constexpr char kReturned = 'R', kThrew = 'T', kOutOfMemory = 'M';
 
 [[noreturn]] void runChild(const std::function<void()>& step, const IsolationLimits& limits,
                            int reply)
@@ -63,7 +65,7 @@ enum ChildStatus { kReturned = 0, kThrew = 1, kOutOfMemory = 3 };
     const rlimit noCore{0, 0};  // a crash here is an answer, not a core file
     ::setrlimit(RLIMIT_CORE, &noCore);
     if (limits.memoryBytes > 0.0) limitAddressSpace(limits.memoryBytes);
-    int status = kReturned;
+    char status = kReturned;
     std::string why;
     try {
         step();
@@ -79,9 +81,9 @@ enum ChildStatus { kReturned = 0, kThrew = 1, kOutOfMemory = 3 };
         status = kThrew;
         why = "an unknown exception";
     }
-    writeAll(reply, why);
+    writeAll(reply, status + why);
     // No destructors, atexit handlers or buffered output of the caller's run twice.
-    ::_exit(status);
+    ::_exit(0);
 }
 
 }  // namespace
@@ -133,9 +135,19 @@ IsolatedOutcome runIsolated(const std::function<void()>& step, const IsolationLi
         message.append(buffer, std::size_t(n));
     }
     ::close(fds[0]);
-    if (timedOut) ::kill(pid, SIGKILL);
+    // The child has closed its end (or its time is up): its exit, within the same deadline.
     int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    bool reaped = false;
+    for (;;) {
+        if (!timedOut && Clock::now() >= deadline) timedOut = true;
+        if (timedOut) ::kill(pid, SIGKILL);
+        const pid_t got = ::waitpid(pid, &status, timedOut ? 0 : WNOHANG);
+        if (got == pid) {
+            reaped = true;
+            break;
+        }
+        if (got < 0 && errno != EINTR) break;  // not ours to wait for: no answer
+        if (got == 0) ::usleep(1000);
     }
 
     using Kind = IsolatedOutcome::Kind;
@@ -144,14 +156,21 @@ IsolatedOutcome runIsolated(const std::function<void()>& step, const IsolationLi
         std::snprintf(text, sizeof text, "took longer than %g s", limits.seconds);
         return {Kind::TimedOut, text};
     }
+    if (!reaped) return {Kind::Crashed, "ended unseen (waitpid failed)"};
     if (WIFSIGNALED(status)) {
         return {Kind::Crashed, std::string("crashed (") + ::strsignal(WTERMSIG(status)) + ")"};
     }
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    if (code == kReturned) return {Kind::Returned, ""};
-    if (code == kThrew && !message.empty()) return {Kind::Threw, message};
-    if (code == kOutOfMemory && !message.empty()) return {Kind::OutOfMemory, message};
-    return {Kind::Crashed, "exited with status " + std::to_string(code)};
+    const char said = message.empty() ? '\0' : message[0];
+    const std::string why = message.empty() ? "" : message.substr(1);
+    if (code != 0 || said == '\0') {
+        return {Kind::Crashed, "exited with status " + std::to_string(code) +
+                                   (said == '\0' ? " before it answered" : "")};
+    }
+    if (said == kReturned) return {Kind::Returned, ""};
+    if (said == kThrew) return {Kind::Threw, why};
+    if (said == kOutOfMemory) return {Kind::OutOfMemory, why};
+    return {Kind::Crashed, "answered what no step says"};
 }
 
 }  // namespace pine::io

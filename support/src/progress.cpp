@@ -20,6 +20,7 @@ Progress::Progress(std::string what)
 
 void Progress::update(double fraction)
 {
+    fraction = fraction >= 0.0 ? std::min(fraction, 1.0) : 0.0;  // NaN too
     char text[8];
     std::snprintf(text, sizeof text, "%3d%%", int(std::lround(100.0 * fraction)));
     show(fraction, text);

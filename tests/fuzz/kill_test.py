@@ -78,6 +78,13 @@ with tempfile.TemporaryDirectory() as work:
         interrupted += status == -signal.SIGKILL
         verified(folder, f"bake killed ({k})")
     print(f"bake scene: {interrupted} of {kills} runs killed mid-way ({whole:.2f} s a run)")
+    # The moment random kills miss: between a manifest's rename and its grid's.
+    killed = subprocess.run([bake, "scene", scene, "--voxel-size", sizes[1], "--out-dir", folder],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            env=dict(os.environ, PINE_KILL_BEFORE_RENAME="tree_001.vdb"))
+    if killed.returncode != -signal.SIGKILL:
+        fail(f"fault injection did not kill bake scene (status {killed.returncode})")
+    verified(folder, "bake killed between a manifest's rename and its grid's")
     timed([bake, "scene", scene, "--voxel-size", sizes[0], "--out-dir", folder])
     verified(folder, "rerun after the kills")
     if temporaries(folder):
@@ -100,14 +107,33 @@ with tempfile.TemporaryDirectory() as work:
     out = os.path.join(work, "render", "b.exr")
     os.makedirs(os.path.dirname(out))
     whole = timed([vdbtrace, "render", bough, "--out", out])
+    png = out[:-4] + ".png"
+
+    def stamps():
+        return os.stat(out).st_mtime_ns, os.stat(png).st_mtime_ns
+
     for k in range(kills):
-        before = os.stat(out).st_mtime_ns
+        exr_before, png_before = stamps()
         killed_after([vdbtrace, "render", bough, "--out", out], rng.uniform(0.0, 1.2 * whole))
         if not exr_whole(out):
             fail(f"render killed ({k}): {out} is not a whole EXR")
-        png = out[:-4] + ".png"
-        if os.stat(out).st_mtime_ns != before and os.stat(png).st_mtime_ns < before:
+        exr_after, png_after = stamps()
+        if exr_after != exr_before and png_after == png_before:
             fail(f"render killed ({k}): a new EXR beside the previous preview")
+    # Killed just before the preview's rename, then just before the EXR's: the EXR is never
+    # newer than its preview.
+    for name in ["b.png", "b.exr"]:
+        exr_before, png_before = stamps()
+        killed = subprocess.run([vdbtrace, "render", bough, "--out", out],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                env=dict(os.environ, PINE_KILL_BEFORE_RENAME=name))
+        if killed.returncode != -signal.SIGKILL:
+            fail(f"fault injection did not kill render before {name} ({killed.returncode})")
+        exr_after, png_after = stamps()
+        if exr_after != exr_before:
+            fail(f"render killed before renaming {name}: the EXR was replaced")
+        if not exr_whole(out):
+            fail(f"render killed before renaming {name}: {out} is not a whole EXR")
     timed([vdbtrace, "render", bough, "--out", out])
     if temporaries(os.path.dirname(out)):
         fail(f"render: temporaries left after a rerun: {temporaries(os.path.dirname(out))}")

@@ -204,15 +204,17 @@ def check(name, argv, out):
                 findings.append(f"{what}: exit 0 with non-finite pixels ({why})")
         outcomes["written"] += 1
     elif status == 2:
-        # Progress lines may come first; the error is the last line, and one line.
+        # Progress and the scene's summary may come first; the error is the last line, the
+        # tool's own (not a library's or the runtime's words).
         last = lines[-1] if lines else ""
-        if not last or "\n" in last.strip():
-            findings.append(f"{what}: exit 2 without a one-line error")
+        if not last.startswith(os.path.basename(argv[0]) + ": "):
+            findings.append(f"{what}: exit 2 without the tool's one-line error: {last[:200]}")
         if any(marker in err for marker in ["terminate called", "Assertion", "runtime error:",
                                             "AddressSanitizer", "std::bad_alloc"]):
             findings.append(f"{what}: exit 2 after {last[:200]}")
-        if os.path.exists(out):
-            findings.append(f"{what}: a refused run left {os.path.basename(out)}")
+        for left in [out, out[:-4] + ".png", out + ".json"]:
+            if os.path.exists(left):
+                findings.append(f"{what}: a refused run left {os.path.basename(left)}")
         outcomes["refused"] += 1
     else:
         findings.append(f"{what}: status {status}: {lines[-1][:200] if lines else ''}")

@@ -8,6 +8,10 @@ the first 2 KiB (header, metadata, topology). Each file must be read or refused 
 and one line naming it, never a signal or a hang: OpenVDB 10.0.1 crashes on some such bytes,
 so the tools parse foreign ones in a child process first.
 
+Under scripts/sanitize.sh a sanitizer's report from the child (OpenVDB's own memory errors on
+damaged bytes, which the child exists to contain) ends that child and counts as a refusal; the
+tool around it is what must survive.
+
 Usage: vdb_fuzz.py BAKE VDBTRACE SOURCE_DIR [FILES] [SEED]. Exits 1 on any finding.
 """
 import json

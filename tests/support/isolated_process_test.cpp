@@ -43,7 +43,11 @@ TEST(IsolatedProcess, AnExitWithoutAReplyIsACrash)
 {
     const IsolatedOutcome outcome = runIsolated([] { ::_exit(7); }, {});
     EXPECT_EQ(outcome.kind, Kind::Crashed);
-    EXPECT_EQ(outcome.why, "exited with status 7");
+    EXPECT_EQ(outcome.why, "exited with status 7 before it answered");
+    // A library that exits with status 0 in the middle of the step has not returned.
+    const IsolatedOutcome quiet = runIsolated([] { ::_exit(0); }, {});
+    EXPECT_EQ(quiet.kind, Kind::Crashed);
+    EXPECT_EQ(quiet.why, "exited with status 0 before it answered");
 }
 
 #if !defined(__SANITIZE_ADDRESS__)
@@ -69,6 +73,14 @@ TEST(IsolatedProcess, AHangIsKilledAtItsDeadline)
     const IsolatedOutcome outcome = runIsolated([] { ::pause(); }, {0.0, 0.3});
     EXPECT_EQ(outcome.kind, Kind::TimedOut);
     EXPECT_EQ(outcome.why, "took longer than 0.3 s");
+    // Its end of the pipe closed, the child still hangs: the same deadline holds.
+    const IsolatedOutcome closed = runIsolated(
+        [] {
+            for (int fd = 3; fd < 1024; ++fd) ::close(fd);
+            ::pause();
+        },
+        {0.0, 0.3});
+    EXPECT_EQ(closed.kind, Kind::TimedOut);
 }
 
 }  // namespace

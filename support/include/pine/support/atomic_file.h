@@ -23,7 +23,8 @@ std::filesystem::path temporaryBeside(const std::filesystem::path& file);
 /// the temporary is removed and `file` is left as it was; throws InputError "cannot write
 /// 'FILE': WHY" (WHY from what the callback threw), except for std::bad_alloc, non-standard
 /// exceptions and InputErrors from beforeRename (which name their own file), rethrown as they
-/// are.
+/// are. For fault-injection tests, PINE_KILL_BEFORE_RENAME=NAME kills the process (SIGKILL)
+/// just before a file named NAME would be renamed into place.
 void writeAtomically(const std::filesystem::path& file,
                      const std::function<void(const std::filesystem::path& temporary)>& write,
                      const std::function<void()>& beforeRename = {});

@@ -11,7 +11,8 @@ namespace pine::io {
 /// An exclusive advisory lock (flock) on a folder, held while the object lives: taken at once if
 /// free, else after calling onWait() (to say so) and waiting. No file is created. Every lock
 /// taken is a separate one, so two in one process also take turns. Locks only runs of these
-/// tools; other programs are not stopped. Throws InputError if the folder cannot be opened.
+/// tools; other programs are not stopped. Where the file system cannot lock a folder (NFS),
+/// no lock is taken. Throws InputError if the folder cannot be opened.
 class FolderLock {
 public:
     explicit FolderLock(const std::filesystem::path& folder,
