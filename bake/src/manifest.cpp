@@ -92,19 +92,15 @@ std::optional<FileDigest> acceptedDigest(const fs::path& file)
     std::error_code error;
     if (!fs::exists(file, error)) return std::nullopt;
     try {
-        const std::string bytes = readVerified(file);
-        Fnv1a64 hash;
-        hash.update(bytes);
         FileDigest digest;
-        digest.bytes = bytes.size();
-        digest.fnv1a64 = hash.value();
+        (void)readVerified(file, &digest);
         return digest;
     } catch (const BakeError&) {
         return std::nullopt;
     }
 }
 
-std::string readVerified(const fs::path& file)
+std::string readVerified(const fs::path& file, FileDigest* digest)
 {
     const auto refuse = [&](const std::string& why) {
         return BakeError("'" + file.string() +
@@ -150,6 +146,7 @@ std::string readVerified(const fs::path& file)
         })) {
         throw refuse("checksum " + hex + ", the manifest says " + accepted.front().fnv1a64);
     }
+    if (digest) *digest = {bytes, hash.value()};
     return content;
 }
 

@@ -43,7 +43,7 @@ std::optional<FileDigest> acceptedDigest(const std::filesystem::path& file);
 
 /// The bytes of `file`, once its manifest is found and its size and checksum match it (or
 /// match the previous file it records). Throws BakeError "'FILE' does not match its manifest
-/// (written by bake?): WHY".
-std::string readVerified(const std::filesystem::path& file);
+/// (written by bake?): WHY". Fills `digest`, if given, with what was checked.
+std::string readVerified(const std::filesystem::path& file, FileDigest* digest = nullptr);
 
 }  // namespace pine::bake::detail

@@ -64,10 +64,7 @@ def replaced(scene, path, value):
     for key in path[:-1]:
         target = target[key]
     if value is KeyError:
-        if isinstance(target, dict):
-            del target[path[-1]]
-        else:
-            del target[path[-1]]
+        del target[path[-1]]
     else:
         target[path[-1]] = value
     return s
