@@ -182,7 +182,6 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
     out.extinctionLaw = settings.extinctionLaw;
     const auto xform = openvdb::math::Transform::createLinearTransform(h);
     for (const FieldInfo& info : kFields) out.setGrid(info.field, makeGrid(info, xform));
-    out.density->setGridClass(openvdb::GRID_FOG_VOLUME);
 
     // Each kept voxel, filled from its bough at the voxel's centre.
     auto density = out.density->getAccessor();
@@ -191,7 +190,6 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
     auto needle = out.needleDirection->getAccessor();
     auto coverage = out.needleCoverage->getAccessor();
     auto albedo = out.needleAlbedo->getAccessor();
-    double maxMean = 0.0;
     for (auto it = keys->cbeginValueOn(); it; ++it) {
         const openvdb::Coord ijk = it.getCoord();
         const std::size_t b = boughOfKey(*it);
@@ -200,9 +198,7 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
         const auto vec = [](const Vec3& v) {
             return openvdb::Vec3s(float(v.x), float(v.y), float(v.z));
         };
-        const double mean = law.meanExtinction(*s);
-        maxMean = std::max(maxMean, mean);
-        density.setValue(ijk, float(mean));
+        density.setValue(ijk, float(law.meanExtinction(*s)));
         gradient.setValue(ijk, vec(s->gradient));
         opacity.setValue(ijk, float(s->layerOpacity));
         needle.setValue(ijk, vec(s->needle));
@@ -210,14 +206,6 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
         albedo.setValue(ijk, vec(boughs[b].needleAlbedo));
     }
 
-    // The fog-volume class wants [0, 1] (DESIGN.md): store density / max with the max apart.
-    out.densityScale_per_cm = maxMean;
-    if (maxMean > 0.0) {
-        const float inv = float(1.0 / maxMean);
-        for (auto it = out.density->beginValueOn(); it; ++it) {
-            it.setValue(std::min(*it * inv, 1.0f));
-        }
-    }
     openvdb::tools::prune(out.density->tree());
     openvdb::tools::prune(out.layerOpacity->tree());
     openvdb::tools::prune(out.needleAlbedo->tree());
@@ -226,7 +214,6 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
     for (int level = 1; level < settings.pyramidLevels; ++level) {
         openvdb::FloatGrid::Ptr coarse = detail::halveResolution(*previous);
         coarse->setName(densityLodName(level));
-        coarse->setGridClass(openvdb::GRID_FOG_VOLUME);
         openvdb::tools::prune(coarse->tree());
         out.densityPyramid.push_back(coarse);
         previous = coarse;

@@ -1,7 +1,5 @@
 #include "density_pyramid.h"
 
-#include <algorithm>
-
 namespace pine::bake::detail {
 
 openvdb::FloatGrid::Ptr halveResolution(const openvdb::FloatGrid& fine)
@@ -26,9 +24,6 @@ openvdb::FloatGrid::Ptr halveResolution(const openvdb::FloatGrid& fine)
             acc.setValue(c, acc.getValue(c) + v);
         }
     }
-    // Eight float terms of at most 1/8 each may round past 1 by an ulp; the fog class wants
-    // [0, 1].
-    for (auto it = coarse->beginValueOn(); it; ++it) it.setValue(std::min(*it, 1.0f));
     return coarse;
 }
 

@@ -12,7 +12,7 @@
 //   the bands along the line (layer_bands.h), so the rate is the law's and the band is the
 //   tracer's; within one layer crossing n = A s_v / |n . d| with the local coverage for A.
 //
-// Both write the rate's mean over directions as `density`: the mean needles met per cm, which
+// Both write the rate's mean over directions as `density`: the mean needles met per length, which
 // is the Poisson medium's extinction (a volume renderer elsewhere sees that medium).
 #include "pine/bake/extinction_law.h"
 
@@ -30,14 +30,14 @@ public:
     std::string formula() const override
     {
         const std::string rate =
-            "needles met per cm along d: needle_coverage |d x needle_direction| "
+            "needles met per unit length along d: needle_coverage |d x needle_direction| "
             "|layer_gradient|; ";
         return rate +
                (mEvenlySpaced ? "each band of one layer along the line (d . layer_gradient of one "
                                 "sign, at most one layer) stopping it with probability min(1, "
                                 "needles met there); "
                               : "sigma(d) = that rate; ") +
-               "density = mean rate / pine:density_scale_per_cm";
+               "density = the rate's mean over directions";
     }
     double extinction(const LayerSample& field, const Vec3& d) const override
     {

@@ -14,8 +14,8 @@ class LayerExtinctionLaw final : public ExtinctionLaw {
 public:
     std::string formula() const override
     {
-        return "sigma(d) = -ln(1 - layer_opacity) |d . layer_gradient| per cm; "
-               "density = mean extinction / pine:density_scale_per_cm";
+        return "sigma(d) = -ln(1 - layer_opacity) |d . layer_gradient| per unit length; "
+               "density = its mean over directions";
     }
     double extinction(const LayerSample& field, const Vec3& d) const override
     {

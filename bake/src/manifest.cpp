@@ -104,7 +104,8 @@ std::string readVerified(const fs::path& file, FileDigest* digest)
 {
     const auto refuse = [&](const std::string& why) {
         return BakeError("'" + file.string() +
-                         "' does not match its manifest (written by bake?): " + why);
+                         "' does not match its manifest (damaged, or changed since bake wrote "
+                         "it: without its manifest it is read unverified): " + why);
     };
     const fs::path manifest = manifestPath(file);
     std::error_code error;
@@ -147,6 +148,21 @@ std::string readVerified(const fs::path& file, FileDigest* digest)
         throw refuse("checksum " + hex + ", the manifest says " + accepted.front().fnv1a64);
     }
     if (digest) *digest = {bytes, hash.value()};
+    return content;
+}
+
+std::string readWhole(const fs::path& file)
+{
+    std::error_code error;
+    if (!fs::is_regular_file(file, error)) throw BakeError("'" + file.string() + "': no such file");
+    const std::uintmax_t bytes = fs::file_size(file, error);
+    if (error) throw BakeError("cannot read '" + file.string() + "': " + error.message());
+    std::string content(bytes, '\0');
+    std::ifstream in(file, std::ios::binary);
+    in.read(content.data(), std::streamsize(bytes));
+    if (!in || std::uintmax_t(in.gcount()) != bytes) {
+        throw BakeError("cannot read '" + file.string() + "' whole");
+    }
     return content;
 }
 

@@ -46,4 +46,7 @@ std::optional<FileDigest> acceptedDigest(const std::filesystem::path& file);
 /// (written by bake?): WHY". Fills `digest`, if given, with what was checked.
 std::string readVerified(const std::filesystem::path& file, FileDigest* digest = nullptr);
 
+/// The bytes of `file`, unchecked (a file without a manifest). Throws BakeError.
+std::string readWhole(const std::filesystem::path& file);
+
 }  // namespace pine::bake::detail

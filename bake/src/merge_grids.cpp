@@ -41,7 +41,6 @@ TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
     for (const FieldInfo& info : kFields) {
         out.setGrid(info.field, first.grid(info.field)->deepCopyGrid());
     }
-    out.densityScale_per_cm = first.densityScale_per_cm;
     for (std::size_t i = 1; i < trees.size(); ++i) {
         const TreeGrids& t = trees[i];
         if (std::abs(t.voxelSize_cm - out.voxelSize_cm) > 1e-9 * out.voxelSize_cm) {
@@ -56,7 +55,6 @@ TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
         // What the trees before this one occupy, fixed while the fields are filled.
         const openvdb::FloatGrid::Ptr occupied = out.layerOpacity->deepCopy();
         for (const FieldInfo& info : kFields) fillInactive(info, out, t, *occupied);
-        out.densityScale_per_cm = std::max(out.densityScale_per_cm, t.densityScale_per_cm);
     }
     return out;
 }

@@ -1,5 +1,6 @@
 #include "pine/bake/tree_boughs.h"
 
+#include "manifest.h"
 #include "pine/scenes/colours.h"
 #include "pine/scenes/tree.h"
 
@@ -34,6 +35,27 @@ std::vector<BoughSpec> treeBoughs(const scenes::Tree& tree)
         out.push_back(spec);
     }
     return out;
+}
+
+std::string treeDigest(const std::vector<BoughSpec>& boughs)
+{
+    detail::Fnv1a64 hash;
+    const auto add = [&](double v) {
+        hash.update(std::string_view(reinterpret_cast<const char*>(&v), sizeof v));
+    };
+    for (const BoughSpec& b : boughs) {
+        for (int i = 0; i < 3; ++i) {
+            add(b.base_cm[i]);
+            add(b.tip_cm[i]);
+            add(b.needleAlbedo[i]);
+        }
+        const analytic::ConeGeometry& c = b.needles.cone;
+        for (double v : {c.aperture_rad, c.needleLength_cm, c.needleRadius_cm,
+                         double(c.needlesPerCone), b.needles.coneSpacing_cm}) {
+            add(v);
+        }
+    }
+    return detail::Fnv1a64::hex(hash.value());
 }
 
 TreeGrids bakeScene(const std::vector<scenes::Tree>& trees, const BakeSettings& settings)

@@ -45,4 +45,13 @@ void TreeGrids::setGrid(Field field, const openvdb::GridBase::Ptr& grid)
     }
 }
 
+const char* unitName(LengthUnit unit) { return unit == LengthUnit::Metre ? "m" : "cm"; }
+
+LengthUnit lengthUnit(const std::string& name)
+{
+    if (name == "m") return LengthUnit::Metre;
+    if (name == "cm") return LengthUnit::Centimetre;
+    throw BakeError("unknown length unit '" + name + "': expected 'm' or 'cm'");
+}
+
 }  // namespace pine::bake

@@ -3,6 +3,7 @@
 #include "pine/bake/resource_estimate.h"
 #include "pine/bake/tree_boughs.h"
 #include "pine/bake/tree_grids.h"
+#include "pine/bake/tree_proxy.h"
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/support/atomic_file.h"
@@ -32,25 +33,49 @@ struct Totals {
     std::atomic<std::uint64_t> voxels{0}, bytes{0};
 };
 
-/// Grows tree `index` of the scene, bakes it and writes it to `out`.
-void bakeTree(const scenes::Scene& scene, const fs::path& sceneFile, std::size_t index,
-              const bake::BakeSettings& settings, const fs::path& out, Totals& totals)
+/// Where and how the files are laid out (--units, --frame).
+struct Output {
+    bake::LengthUnit unit = bake::LengthUnit::Metre;
+    bool treeFrame = true;
+};
+
+/// The mesh of the trunk and branches beside a tree's grids.
+fs::path meshBeside(const fs::path& grids)
+{
+    fs::path mesh = grids;
+    return mesh.replace_extension(".obj");
+}
+
+/// Grows tree `index` of the scene, bakes it and writes its grids to `out` and its branch mesh
+/// beside them; returns its entry of the instance list.
+bake::ProxyInstance bakeTree(const scenes::Scene& scene, const fs::path& sceneFile,
+                             std::size_t index, const bake::BakeSettings& settings,
+                             const Output& output, const fs::path& out, Totals& totals)
 {
     const scenes::TreePlacement& placement = scene.trees[index];
     const scenes::Tree tree = scenes::growTree(scene.species.at(placement.species), placement);
-    const bake::TreeGrids grids = bake::bakeBoughs(bake::treeBoughs(tree), settings);
-    bake::writeTreeGrids(grids, out, {sceneFile.string(), int(index), placement.seed});
+    const std::vector<bake::BoughSpec> boughs = bake::treeBoughs(tree);
+    const bake::TreeGrids grids = bake::bakeBoughs(boughs, settings);
+    bake::FileLayout layout{output.unit, std::nullopt};
+    if (output.treeFrame) layout.treeFrame = bake::treeFrame(placement);
+    io::writeTextAtomically(meshBeside(out), bake::branchMeshObj(tree, layout));
+    bake::writeTreeGrids(grids, out,
+                         {sceneFile.string(), int(index), placement.seed, bake::treeDigest(boughs)},
+                         layout);
     totals.trees += 1;
     totals.voxels += grids.density->activeVoxelCount();
-    totals.bytes += std::uint64_t(fs::file_size(out));
+    totals.bytes += std::uint64_t(fs::file_size(out)) + std::uint64_t(fs::file_size(meshBeside(out)));
+    return {int(index),         out.filename().string(), meshBeside(out).filename().string(),
+            placement.species, placement.seed,          layout.treeFrame};
 }
 
 void summarize(const Totals& totals, std::chrono::steady_clock::time_point start)
 {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "bake: %zu trees, %llu voxels, %llu bytes, %.2f s, peak %.0f MiB\n",
-                 totals.trees.load(), static_cast<unsigned long long>(totals.voxels.load()),
+    const std::size_t trees = totals.trees.load();
+    std::fprintf(stderr, "bake: %zu %s, %llu voxels, %llu bytes, %.2f s, peak %.0f MiB\n",
+                 trees, trees == 1 ? "tree" : "trees", static_cast<unsigned long long>(totals.voxels.load()),
                  static_cast<unsigned long long>(totals.bytes.load()), seconds,
                  tool::peakMemoryMiB());
 }
@@ -64,11 +89,16 @@ bake::BakeSettings forScene(bake::BakeSettings settings, const std::string& law,
 }
 
 int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& common,
-            const std::string& law, const fs::path& out, double maxMemoryGiB)
+            const std::string& law, const Output& output, const fs::path& out,
+            double maxMemoryGiB)
 {
     const auto start = std::chrono::steady_clock::now();
+    if (out.extension() != ".vdb") {
+        throw InputError("--out '" + out.string() + "': the grids' name must end in .vdb (the " +
+                         "branch mesh goes beside it as .obj)");
+    }
     io::checkWritable(out);  // before the work, not after it
-    io::checkOutputsApart({out, out.string() + ".json"}, {sceneFile});
+    io::checkOutputsApart({out, out.string() + ".json", meshBeside(out)}, {sceneFile});
     const scenes::Scene scene = scenes::loadScene(sceneFile);
     const bake::BakeSettings settings = forScene(common, law, scene);
     if (tree < 0 || std::size_t(tree) >= scene.trees.size()) {
@@ -79,7 +109,7 @@ int bakeOne(const fs::path& sceneFile, int tree, const bake::BakeSettings& commo
     bake::checkMemory(bake::estimateBake(scene, {std::size_t(tree)}, settings.voxelSize_cm),
                       bake::memoryLimit(maxMemoryGiB), sceneFile.string());
     Totals totals;
-    bakeTree(scene, sceneFile, std::size_t(tree), settings, out, totals);
+    (void)bakeTree(scene, sceneFile, std::size_t(tree), settings, output, out, totals);
     summarize(totals, start);
     return 0;
 }
@@ -92,7 +122,7 @@ fs::path treeFile(const fs::path& dir, std::size_t index)
 }
 
 int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const std::string& law,
-              const fs::path& dir, double maxMemoryGiB)
+              const Output& output, const fs::path& dir, double maxMemoryGiB)
 {
     const auto start = std::chrono::steady_clock::now();
     io::checkWritableFolder(dir);
@@ -106,17 +136,24 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
         bake::estimateBake(scene, all, settings.voxelSize_cm,
                            std::size_t(tbb::this_task_arena::max_concurrency())),
         bake::memoryLimit(maxMemoryGiB), sceneFile.string());
+    const fs::path listFile = dir / "instances.json";
     for (std::size_t i = 0; i < n; ++i) {  // the names differ; the scene may be among them
-        io::checkOutputsApart({treeFile(dir, i), treeFile(dir, i).string() + ".json"}, {sceneFile});
+        io::checkOutputsApart({treeFile(dir, i), treeFile(dir, i).string() + ".json",
+                               meshBeside(treeFile(dir, i)), listFile},
+                              {sceneFile});
     }
     Totals totals;
+    std::vector<bake::ProxyInstance> instances(n);
     tool::Progress progress("bake:");
     // Trees in parallel, one task each; bakeBoughs also splits a tree's boughs among threads.
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
-        bakeTree(scene, sceneFile, i, settings, treeFile(dir, i), totals);
+        instances[i] = bakeTree(scene, sceneFile, i, settings, output, treeFile(dir, i), totals);
         progress.count(totals.trees.load(), n, "trees");
     });
     progress.finish();
+    // Last: a list names only files already in place.
+    io::writeTextAtomically(
+        listFile, bake::instanceList(sceneFile.string(), output.unit, instances).dump(1) + "\n");
     summarize(totals, start);
     return 0;
 }
@@ -152,11 +189,14 @@ int verify(const std::vector<fs::path>& paths, double maxMemoryGiB)
     int refused = 0;
     for (const fs::path& file : files) {
         try {
-            const bake::TreeGrids grids =
+            const bake::ReadGrids read =
                 bake::readTreeGrids(file, bake::memoryLimit(maxMemoryGiB));
-            std::cout << file.string() << ": ok, " << grids.density->activeVoxelCount()
-                      << " voxels of " << grids.voxelSize_cm << " cm, extinction law "
-                      << grids.extinctionLaw << "\n";
+            const bake::TreeGrids& grids = read.grids;
+            std::cout << file.string() << ": " << (read.unverified.empty() ? "ok" : "unverified")
+                      << ", " << grids.density->activeVoxelCount() << " voxels of "
+                      << grids.voxelSize_cm << " cm, extinction law " << grids.extinctionLaw;
+            if (!read.unverified.empty()) std::cout << " (" << read.unverified << ")";
+            std::cout << "\n";
         } catch (const InputError& e) {
             std::cout << file.string() << ": refused: " << e.what() << "\n";
             ++refused;
@@ -179,7 +219,7 @@ int main(int argc, char** argv)
     int tree = 0;
     double maxMemoryGiB = 0.0;  // 0: bake::defaultMemoryLimit()
     bake::BakeSettings settings;
-    std::string law;
+    std::string law, units = "m", frame = "tree";
     const CLI::Validator positive = tool::positiveNumber();
     const auto addCommon = [&](CLI::App* cmd) {
         cmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
@@ -199,13 +239,25 @@ int main(int argc, char** argv)
                         "Density levels at h, 2h, 4h, ... (1: no pyramid)")
             ->default_val(settings.pyramidLevels)
             ->check(CLI::Range(1, 16));
+        cmd->add_option("--units", units,
+                        "Length unit of the files (transform, extinction per unit length, mesh)")
+            ->default_val(units)
+            ->check(CLI::IsMember({"m", "cm"}));
+        cmd->add_option("--frame", frame,
+                        "tree: each tree in its own frame, origin at its base (placements in "
+                        "instances.json); world: the scene's frame")
+            ->default_val(frame)
+            ->check(CLI::IsMember({"tree", "world"}));
     };
     auto* treeCmd = app.add_subcommand("tree", "Bake one tree of a scene into one .vdb");
     addCommon(treeCmd);
     treeCmd->add_option("--tree", tree, "Index of the tree in the scene (from 0)")->required();
-    treeCmd->add_option("--out", out, "Output .vdb; its manifest goes to OUT.json")->required();
+    treeCmd->add_option("--out", out, "Output .vdb; its manifest goes to OUT.json, the branch "
+                                      "mesh beside it as .obj")
+        ->required();
 
-    auto* sceneCmd = app.add_subcommand("scene", "Bake every tree: DIR/tree_000.vdb, ...");
+    auto* sceneCmd = app.add_subcommand(
+        "scene", "Bake every tree: DIR/tree_000.vdb (+ .obj mesh), ..., DIR/instances.json");
     addCommon(sceneCmd);
     sceneCmd->add_option("--out-dir", outDir, "Output folder (created if missing)")->required();
 
@@ -219,8 +271,9 @@ int main(int argc, char** argv)
         ->check(positive);
 
     return tool::run("bake", app, argc, argv, [&] {
-        if (*treeCmd) return bakeOne(sceneFile, tree, settings, law, out, maxMemoryGiB);
+        const Output output{bake::lengthUnit(units), frame == "tree"};
+        if (*treeCmd) return bakeOne(sceneFile, tree, settings, law, output, out, maxMemoryGiB);
         if (*verifyCmd) return verify(verifyPaths, maxMemoryGiB);
-        return bakeScene(sceneFile, settings, law, outDir, maxMemoryGiB);
+        return bakeScene(sceneFile, settings, law, output, outDir, maxMemoryGiB);
     });
 }

@@ -33,7 +33,7 @@ TreeGrids twoBoughs(double voxelSize_cm = 0.4, int levels = 3)
     return bakeBoughs({a, b}, BakeSettings{voxelSize_cm, levels});
 }
 
-const BakeProvenance kProvenance{"scenes/test.json", 7, 4200432988u};
+const BakeProvenance kProvenance{"scenes/test.json", 7, 4200432988u, "0123456789abcdef"};
 
 std::string readFile(const fs::path& file)
 {
@@ -66,30 +66,140 @@ void expectSameGrid(const GridT& expected, const GridT& actual)
     }
 }
 
-TEST(TreeGridsIo, RoundTripKeepsValuesAndScale)
+double magnitude(float v) { return std::abs(double(v)); }
+double magnitude(const openvdb::Vec3s& v) { return double(v.length()); }
+
+/// Expects `actual` to hold `expected`'s voxels, each value within `tolerance` (relative).
+template <class GridT>
+void expectNearGrid(const GridT& expected, const GridT& actual, double tolerance)
+{
+    EXPECT_EQ(expected.getName(), actual.getName());
+    EXPECT_EQ(expected.transform(), actual.transform()) << expected.getName();
+    EXPECT_EQ(expected.activeVoxelCount(), actual.activeVoxelCount()) << expected.getName();
+    auto acc = actual.getConstAccessor();
+    for (auto it = expected.cbeginValueOn(); it; ++it) {
+        ASSERT_TRUE(acc.isValueOn(it.getCoord())) << expected.getName() << it.getCoord();
+        const auto e = *it, a = acc.getValue(it.getCoord());
+        ASSERT_LE(magnitude(e - a), tolerance * magnitude(e) + 1e-30)
+            << expected.getName() << it.getCoord() << ": " << e << " against " << a;
+    }
+}
+
+void expectSameGrids(const TreeGrids& g, const TreeGrids& r, double tolerance)
+{
+    const auto same = [&](const auto& e, const auto& a) {
+        if (tolerance == 0.0) {
+            expectSameGrid(e, a);
+        } else {
+            expectNearGrid(e, a, tolerance);
+        }
+    };
+    same(*g.density, *r.density);
+    same(*g.layerGradient, *r.layerGradient);
+    same(*g.layerOpacity, *r.layerOpacity);
+    same(*g.needleDirection, *r.needleDirection);
+    same(*g.needleCoverage, *r.needleCoverage);
+    same(*g.needleAlbedo, *r.needleAlbedo);
+    ASSERT_EQ(r.densityPyramid.size(), g.densityPyramid.size());
+    for (std::size_t i = 0; i < g.densityPyramid.size(); ++i) {
+        same(*g.densityPyramid[i], *r.densityPyramid[i]);
+    }
+    EXPECT_EQ(r.voxelSize_cm, g.voxelSize_cm);
+    EXPECT_EQ(r.extinctionLaw, g.extinctionLaw);
+}
+
+TEST(TreeGridsIo, RoundTripKeepsValuesInEveryUnitAndFrame)
 {
     const test::TempDir dir;
     const TreeGrids g = twoBoughs();
-    const fs::path file = dir.path() / "tree.vdb";
-    writeTreeGrids(g, file, kProvenance);
-    const TreeGrids r = readTreeGrids(file);
-    expectSameGrid(*g.density, *r.density);
-    expectSameGrid(*g.layerGradient, *r.layerGradient);
-    expectSameGrid(*g.layerOpacity, *r.layerOpacity);
-    expectSameGrid(*g.needleDirection, *r.needleDirection);
-    expectSameGrid(*g.needleAlbedo, *r.needleAlbedo);
     ASSERT_EQ(g.densityPyramid.size(), 2u);
-    ASSERT_EQ(r.densityPyramid.size(), 2u);
-    for (std::size_t i = 0; i < 2; ++i) expectSameGrid(*g.densityPyramid[i], *r.densityPyramid[i]);
-    EXPECT_EQ(r.densityScale_per_cm, g.densityScale_per_cm);
-    EXPECT_EQ(r.voxelSize_cm, 0.4);
-    // Writing adds metadata to what it writes, not to the caller's grids.
-    EXPECT_FALSE(g.density->getMetadata<openvdb::DoubleMetadata>("pine:density_scale_per_cm"));
+    const fs::path file = dir.path() / "tree.vdb";
+    // In cm and the world's frame nothing is converted: every voxel comes back bit for bit.
+    writeTreeGrids(g, file, kProvenance, {LengthUnit::Centimetre, std::nullopt});
+    ReadGrids r = readTreeGrids(file);
+    expectSameGrids(g, r.grids, 0.0);
+    EXPECT_EQ(r.unverified, "");
+    EXPECT_EQ(r.provenance.scene, kProvenance.scene);
+    EXPECT_EQ(r.provenance.tree, kProvenance.tree);
+    EXPECT_EQ(r.provenance.seed, kProvenance.seed);
+    EXPECT_EQ(r.provenance.treeDigest, kProvenance.treeDigest);
+    // In metres, in a tree's frame, turned: back on the scene's lattice within float rounding
+    // of the values (scaled by 100 and turned, then back).
+    for (const double turn : {0.0, 0.7, -2.5}) {
+        const FileLayout layout{LengthUnit::Metre, TreeFrame{Vec3(123.4, -56.7, 8.9), turn}};
+        writeTreeGrids(g, file, kProvenance, layout);
+        r = readTreeGrids(file);
+        expectSameGrids(g, r.grids, 4e-7);
+    }
+    // Writing changes what it writes, not the caller's grids.
+    EXPECT_FALSE(g.density->getMetadata<openvdb::StringMetadata>("pine:units"));
+    EXPECT_EQ(g.density->transform(), *openvdb::math::Transform::createLinearTransform(0.4));
     // Only the file and its manifest: no temporary left behind.
     EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 2);
 }
 
-TEST(TreeGridsIo, OpenVdbSeesAFogVolumeFirstWithItsProvenance)
+TEST(TreeGridsIo, InATreesFrameTheTreeStandsAtTheOriginInMetres)
+{
+    // What a Blender or Houdini user sees: world positions in the tree's frame, in metres,
+    // extinction per metre, vectors turned with the tree.
+    const test::TempDir dir;
+    const TreeGrids g = twoBoughs();
+    const fs::path file = dir.path() / "tree.vdb";
+    const Vec3 base(-300.0, 250.0, 12.0);
+    const double turn = 0.6;
+    writeTreeGrids(g, file, kProvenance, {LengthUnit::Metre, TreeFrame{base, turn}});
+    openvdb::io::File in(file.string());
+    in.open();
+    const openvdb::GridPtrVecPtr grids = in.getGrids();
+    const openvdb::MetaMap::Ptr meta = in.getMetadata();
+    in.close();
+    const auto find = [&](const std::string& name) {
+        for (const auto& grid : *grids) {
+            if (grid->getName() == name) return grid;
+        }
+        return openvdb::GridBase::Ptr();
+    };
+    const auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(find("density"));
+    const auto needle = openvdb::gridPtrCast<openvdb::Vec3SGrid>(find("needle_direction"));
+    const auto gradient = openvdb::gridPtrCast<openvdb::Vec3SGrid>(find("layer_gradient"));
+    ASSERT_TRUE(density && needle && gradient);
+    EXPECT_EQ(meta->metaValue<std::string>("pine:units"), "m");
+    EXPECT_EQ(meta->metaValue<std::string>("pine:frame"), "tree");
+    EXPECT_EQ(meta->metaValue<double>("pine:voxel_size"), 0.004);
+    const double c = std::cos(turn), s = std::sin(turn);
+    const auto intoTree = [&](const Vec3& p) {  // R(-turn) (p - base), independently of bake
+        const Vec3 q = p - base;
+        return Vec3(c * q.x + s * q.y, -s * q.x + c * q.y, q.z);
+    };
+    auto inMemory = g.density->getConstAccessor();
+    auto memNeedle = g.needleDirection->getConstAccessor();
+    auto memGradient = g.layerGradient->getConstAccessor();
+    auto fileNeedle = needle->getConstAccessor();
+    auto fileGradient = gradient->getConstAccessor();
+    int checked = 0;
+    for (auto it = density->cbeginValueOn(); it; ++it, ++checked) {
+        const openvdb::Coord ijk = it.getCoord();
+        // The same voxel of the scene's lattice, its centre in the tree's frame in metres.
+        const openvdb::Vec3d w = density->indexToWorld(ijk);
+        const Vec3 expected = intoTree(Vec3(ijk.x(), ijk.y(), ijk.z()) * 0.4) / 100.0;
+        ASSERT_NEAR(w.x(), expected.x, 1e-9) << ijk;
+        ASSERT_NEAR(w.y(), expected.y, 1e-9) << ijk;
+        ASSERT_NEAR(w.z(), expected.z, 1e-9) << ijk;
+        ASSERT_NEAR(*it, inMemory.getValue(ijk) * 100.0, 1e-5 * *it) << ijk;  // per m
+        const auto mn = memNeedle.getValue(ijk), fn = fileNeedle.getValue(ijk);
+        const Vec3 turned = intoTree(Vec3(mn.x(), mn.y(), mn.z()) + base);
+        ASSERT_NEAR(fn.x(), turned.x, 1e-6);
+        ASSERT_NEAR(fn.y(), turned.y, 1e-6);
+        ASSERT_NEAR(fn.z(), turned.z, 1e-6);
+        const auto mg = memGradient.getValue(ijk), fg = fileGradient.getValue(ijk);
+        const Vec3 perMetre = intoTree(Vec3(mg.x(), mg.y(), mg.z()) + base) * 100.0;
+        ASSERT_NEAR(fg.x(), perMetre.x, 1e-5 * glm::length(perMetre));
+        ASSERT_NEAR(fg.z(), perMetre.z, 1e-5 * glm::length(perMetre));
+    }
+    EXPECT_EQ(checked, int(g.density->activeVoxelCount()));
+}
+
+TEST(TreeGridsIo, OpenVdbSeesDensityFirstWithItsProvenance)
 {
     // Read back with OpenVDB's own file reader, as a third-party tool would.
     const test::TempDir dir;
@@ -101,14 +211,18 @@ TEST(TreeGridsIo, OpenVdbSeesAFogVolumeFirstWithItsProvenance)
     const openvdb::GridPtrVecPtr grids = in.getGrids();
     const openvdb::MetaMap::Ptr meta = in.getMetadata();
     in.close();
-    // io::File lists grids by name; density comes first there too.
+    // io::File lists grids by name; density is its first float grid (what vdb_render takes).
     ASSERT_EQ(grids->size(), std::size(kFields) + g.densityPyramid.size());
-    EXPECT_EQ((*grids)[0]->getName(), "density");
-    // In the file itself (io::Stream reads it in order) density is written first.
+    const auto firstFloat = std::find_if(grids->begin(), grids->end(), [](const auto& grid) {
+        return openvdb::gridConstPtrCast<openvdb::FloatGrid>(grid) != nullptr;
+    });
+    ASSERT_NE(firstFloat, grids->end());
+    EXPECT_EQ((*firstFloat)->getName(), "density");
+    // In the file itself (io::Stream reads it in order) density is written first; the levels
+    // are named as vdb_lod names them.
     const std::vector<std::string> names = {"density", "layer_gradient", "layer_opacity",
-                                            "needle_direction", "needle_coverage", "needle_albedo",
-                                            "density_lod1",
-                                            "density_lod2"};
+                                            "needle_direction", "needle_coverage", "color",
+                                            "density_level_1", "density_level_2"};
     {
         std::ifstream raw(file, std::ios::binary);
         openvdb::io::Stream stream(raw, /*delayLoad=*/false);
@@ -119,38 +233,44 @@ TEST(TreeGridsIo, OpenVdbSeesAFogVolumeFirstWithItsProvenance)
         }
     }
 
-    const auto density = openvdb::gridPtrCast<openvdb::FloatGrid>((*grids)[0]);
+    // density is extinction per metre (the default unit), not a normalized fog volume.
+    const auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(*firstFloat);
     ASSERT_TRUE(density);
-    EXPECT_EQ(density->getGridClass(), openvdb::GRID_FOG_VOLUME);
-    float lo = 2.0f, hi = -1.0f;
+    EXPECT_EQ(density->getGridClass(), openvdb::GRID_UNKNOWN);
+    auto inMemory = g.density->getConstAccessor();
+    float lo = 1e30f, hi = -1.0f;
     for (auto it = density->cbeginValueOn(); it; ++it) {
         lo = std::min(lo, *it);
         hi = std::max(hi, *it);
+        ASSERT_NEAR(*it, 100.0 * inMemory.getValue(it.getCoord()), 1e-6 * *it);
     }
     EXPECT_GT(lo, 0.0f);
-    EXPECT_NEAR(hi, 1.0f, 2e-7f);  // the densest voxel, normalized: 1 within float rounding
-    EXPECT_LE(hi, 1.0f);
-    const auto scale = density->getMetadata<openvdb::DoubleMetadata>("pine:density_scale_per_cm");
-    ASSERT_TRUE(scale);
-    EXPECT_EQ(scale->value(), g.densityScale_per_cm);
+    EXPECT_GT(hi, 2.0f * lo);  // a field, not an occupancy mask
+    EXPECT_TRUE(density->getMetadata<openvdb::StringMetadata>("pine:units"));
 
     ASSERT_TRUE(meta);
-    EXPECT_EQ(meta->metaValue<std::string>("pine:units"), "cm");
+    EXPECT_EQ(meta->metaValue<std::string>("pine:units"), "m");
+    EXPECT_EQ(meta->metaValue<std::string>("pine:density_unit"), "extinction per m");
+    EXPECT_EQ(meta->metaValue<std::string>("pine:frame"), "world");
     EXPECT_EQ(meta->metaValue<openvdb::Int32>("pine:format_version"), kFormatVersion);
     EXPECT_EQ(meta->metaValue<std::string>("pine:extinction_law"), "fibre");
     EXPECT_EQ(meta->metaValue<std::string>("pine:extinction"), extinctionLaw("fibre").formula());
     EXPECT_EQ(meta->metaValue<double>("pine:voxel_size_cm"), 0.4);
+    EXPECT_EQ(meta->metaValue<double>("pine:voxel_size"), 0.004);
     EXPECT_EQ(meta->metaValue<std::string>("pine:scene"), "scenes/test.json");
     EXPECT_EQ(meta->metaValue<openvdb::Int32>("pine:tree"), 7);
     EXPECT_EQ(meta->metaValue<openvdb::Int64>("pine:seed"), 4200432988);
+    EXPECT_EQ(meta->metaValue<std::string>("pine:tree_digest"), kProvenance.treeDigest);
     EXPECT_FALSE(meta->metaValue<std::string>("pine:tool_version").empty());
-    // The full-resolution grids share one transform: voxel centres at ijk h.
+    // The full-resolution grids share one transform: voxel centres at ijk h, in metres.
     for (const auto& grid : *grids) {
-        if (grid->getName().find("_lod") != std::string::npos) continue;
+        if (grid->getName().find("_level_") != std::string::npos) continue;
         EXPECT_EQ(grid->transform(), density->transform()) << grid->getName();
     }
-    EXPECT_EQ(density->indexToWorld(openvdb::Coord(3, -2, 5)),
-              openvdb::Vec3d(3 * 0.4, -2 * 0.4, 5 * 0.4));
+    const openvdb::Vec3d p = density->indexToWorld(openvdb::Coord(3, -2, 5));
+    EXPECT_NEAR(p.x(), 3 * 0.004, 1e-15);
+    EXPECT_NEAR(p.y(), -2 * 0.004, 1e-15);
+    EXPECT_NEAR(p.z(), 5 * 0.004, 1e-15);
 }
 
 TEST(TreeGridsIo, VdbPrintListsEveryGrid)
@@ -162,7 +282,7 @@ TEST(TreeGridsIo, VdbPrintListsEveryGrid)
     ASSERT_EQ(std::system(("vdb_print " + quoted(file) + " > " + quoted(listing)).c_str()), 0);
     const std::string text = readFile(listing);
     for (const char* name : {"density ", "layer_gradient", "layer_opacity", "needle_direction",
-                             "needle_albedo", "density_lod1", "density_lod2"}) {
+                             "color", "density_level_1", "density_level_2"}) {
         EXPECT_NE(text.find(name), std::string::npos) << name << " not in:\n" << text;
     }
 }
@@ -176,7 +296,7 @@ TEST(TreeGridsIo, VdbRenderDrawsTheDensity)
     const fs::path file = dir.path() / "tree.vdb", image = dir.path() / "tree.ppm";
     writeTreeGrids(twoBoughs(), file, kProvenance);
     const std::string command = "vdb_render " + quoted(file) + " " + quoted(image) +
-                                " -gain 0 -cutoff 0 -res 64x64 -translate 0,0,40"
+                                " -gain 0 -cutoff 0 -res 64x64 -translate 0,0,0.4"
                                 " -lookat 0,0,0 -cpus 1 > /dev/null 2>&1";
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
     // Binary PPM: "P6\n64 64\n255\n" then 64 x 64 RGB bytes; the background is black.
@@ -188,7 +308,8 @@ TEST(TreeGridsIo, VdbRenderDrawsTheDensity)
     for (std::size_t i = header.size(); i < ppm.size(); i += 3) {
         lit += (ppm[i] != 0 || ppm[i + 1] != 0 || ppm[i + 2] != 0);
     }
-    // Two 16 cm boughs 3.3 cm thick seen from 40 cm with a 44.8 degree field: a cross over
+    // Two 16 cm boughs 3.3 cm thick seen from 40 cm (the file is in metres) with a 44.8
+    // degree field: a cross over
     // roughly a tenth of the frame.
     EXPECT_GT(lit, 200);
     EXPECT_LT(lit, 64 * 64 / 2);
@@ -226,7 +347,7 @@ TEST(TreeGridsIo, DamagedFilesAreRefusedBeforeOpenVdbReadsThem)
     const fs::path file = written(dir);
     const std::string good = readFile(file);
     ASSERT_GT(good.size(), 1000u);
-    const std::string mismatch = "does not match its manifest (written by bake?)";
+    const std::string mismatch = "does not match its manifest (damaged";
 
     // One byte flipped, anywhere: header, metadata, descriptors, compressed data.
     for (const double where : {0.001, 0.1, 0.5, 0.9, 0.999}) {
@@ -245,15 +366,13 @@ TEST(TreeGridsIo, DamagedFilesAreRefusedBeforeOpenVdbReadsThem)
     EXPECT_NO_THROW(readTreeGrids(file));
 }
 
-TEST(TreeGridsIo, AMissingOrForeignManifestIsRefused)
+TEST(TreeGridsIo, AForeignManifestIsRefused)
 {
     const test::TempDir dir;
     const fs::path file = written(dir);
     const fs::path manifest = file.string() + ".json";
     const std::string good = readFile(manifest);
 
-    fs::remove(manifest);
-    expectRefused(file, "no manifest");
     writeFile(manifest, "{\"file\": \"tree.vdb\"");
     expectRefused(file, "unreadable manifest");
     writeFile(manifest, "{\"file\": \"tree.vdb\", \"bytes\": \"many\", \"fnv1a64\": \"0\"}");
@@ -379,11 +498,67 @@ TEST(TreeGridsIo, AnotherFormatVersionOrAnUnknownLawIsRefused)
     // A pyramid level of another type is refused, not taken as the pyramid's end.
     openvdb::GridPtrVec wrongLod = *grids;
     wrongLod.push_back(openvdb::Vec3SGrid::create());
-    wrongLod.back()->setName("density_lod1");
+    wrongLod.back()->setName("density_level_1");
     rewrite(*meta, &wrongLod);
-    expectRefused(file, "grid 'density_lod1' has type Tree_vec3s");
+    expectRefused(file, "grid 'density_level_1' has type Tree_vec3s");
+    openvdb::MetaMap noUnit = *meta;
+    noUnit.insertMeta("pine:units", openvdb::StringMetadata("furlong"));
+    rewrite(noUnit);
+    expectRefused(file, "unknown length unit 'furlong'");
+    openvdb::MetaMap noFrame = *meta;
+    noFrame.insertMeta("pine:frame", openvdb::StringMetadata("tree"));
+    rewrite(noFrame);
+    expectRefused(file, "frame 'tree' without pine:tree_base_cm");
+    // A grid moved off the lattice its metadata states (resampled elsewhere) is refused.
+    openvdb::GridPtrVec moved = *grids;
+    for (auto& grid : moved) {
+        if (grid->getName() != "layer_opacity") continue;
+        grid = grid->copyGrid();
+        auto xform = grid->transform().copy();
+        xform->postTranslate(openvdb::Vec3d(0.001, 0.0, 0.0));
+        grid->setTransform(xform);
+    }
+    rewrite(*meta, &moved);
+    expectRefused(file, "grid 'layer_opacity' is not on the lattice");
     rewrite(*meta);
-    EXPECT_EQ(readTreeGrids(file).extinctionLaw, BakeSettings{}.extinctionLaw);
+    EXPECT_EQ(readTreeGrids(file).grids.extinctionLaw, BakeSettings{}.extinctionLaw);
+}
+
+TEST(TreeGridsIo, AGridWithoutAManifestIsReadUnverifiedFromItsMetadata)
+{
+    // A bake copied or edited elsewhere without its manifest: read, and said to be unverified.
+    const test::TempDir dir;
+    const fs::path file = written(dir);
+    const ReadGrids verified = readTreeGrids(file);
+    fs::remove(file.string() + ".json");
+    const ReadGrids read = readTreeGrids(file);
+    EXPECT_NE(read.unverified.find("no manifest 'tree.vdb.json'"), std::string::npos)
+        << read.unverified;
+    expectSameGrids(verified.grids, read.grids, 0.0);
+    EXPECT_EQ(read.provenance.treeDigest, kProvenance.treeDigest);
+
+    // A grid another tool made with nothing said of it: refused in one line.
+    const fs::path foreign = dir.path() / "foreign.vdb";
+    {
+        openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.0f);
+        density->setName("density");
+        density->tree().setValue(openvdb::Coord(1, 2, 3), 0.5f);
+        openvdb::io::File out(foreign.string());
+        out.write({density});
+        out.close();
+    }
+    expectRefused(foreign, "no manifest beside it and no pine:format_version metadata");
+    // Damaged bytes without a manifest: parsed in the isolated child, refused, never fatal.
+    std::string bad = readFile(file);
+    bad.resize(bad.size() / 2);
+    writeFile(file, bad);
+    try {
+        readTreeGrids(file);
+        ADD_FAILURE() << "a truncated file without a manifest was read";
+    } catch (const BakeError& e) {
+        EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(readTreeGrids(dir.path() / "missing.vdb"), BakeError);
 }
 
 TEST(TreeGridsIo, UnwritableOutputIsABakeErrorAndLeavesNothing)
@@ -414,7 +589,7 @@ TEST(TreeGridsIo, RewritingReplacesTheFileAndItsManifest)
     writeTreeGrids(twoBoughs(0.8, 1), file, kProvenance);
     const TreeGrids finer = twoBoughs(0.5, 2);
     writeTreeGrids(finer, file, kProvenance);
-    const TreeGrids r = readTreeGrids(file);
+    const TreeGrids r = readTreeGrids(file).grids;
     EXPECT_EQ(r.voxelSize_cm, 0.5);
     EXPECT_EQ(r.densityPyramid.size(), 1u);
     EXPECT_EQ(r.density->activeVoxelCount(), finer.density->activeVoxelCount());
@@ -440,7 +615,7 @@ TEST(TreeGridsIo, AFailedManifestLeavesThePreviousPairAndAKilledBakesTemporaries
     EXPECT_EQ(readBytes(file), before);
     fs::remove(file.string() + ".json");
     std::ofstream(file.string() + ".json", std::ios::binary) << manifest;
-    EXPECT_EQ(readTreeGrids(file).voxelSize_cm, 0.8);
+    EXPECT_EQ(readTreeGrids(file).grids.voxelSize_cm, 0.8);
     // The stale temporaries were removed by that write; nothing of its own is left.
     std::vector<std::string> names;
     for (const auto& e : fs::directory_iterator(dir.path())) {
@@ -450,7 +625,7 @@ TEST(TreeGridsIo, AFailedManifestLeavesThePreviousPairAndAKilledBakesTemporaries
     EXPECT_EQ(names, (std::vector<std::string>{"tree.vdb", "tree.vdb.json"}));
     // And the next bake replaces both.
     writeTreeGrids(twoBoughs(0.5, 2), file, kProvenance);
-    EXPECT_EQ(readTreeGrids(file).voxelSize_cm, 0.5);
+    EXPECT_EQ(readTreeGrids(file).grids.voxelSize_cm, 0.5);
 }
 
 }  // namespace

@@ -23,6 +23,9 @@ expect_error "negative voxel size" 2 "voxel-size" -- scene "$bough" --voxel-size
 expect_error "bad levels" 2 "levels" -- tree "$bough" --tree 0 --voxel-size 1 --levels 0 --out "$work/a.vdb"
 expect_error "missing option" 2 "out" -- tree "$bough" --tree 0 --voxel-size 1
 expect_error "no subcommand" 2 "subcommand" --
+expect_error "grids not named .vdb" 2 "must end in .vdb" -- tree "$bough" --tree 0 --voxel-size 1 --out "$work/a.exr"
+expect_error "unknown unit" 2 "units" -- tree "$bough" --tree 0 --voxel-size 1 --units ft --out "$work/a.vdb"
+expect_error "unknown frame" 2 "frame" -- scene "$bough" --voxel-size 1 --frame local --out-dir "$work"
 # Voxels too fine for the machine: refused before the bake.
 expect_error "fine voxels, one tree" 2 "voxels of 0.001 cm" -- tree "$src/scenes/three-firs.json" --tree 2 --voxel-size 1e-3 --out "$work/a.vdb"
 expect_error "fine voxels, all trees" 2 "more than --max-memory" -- scene "$bough" --voxel-size 0.05 --max-memory 0.01 --out-dir "$work"
@@ -50,28 +53,40 @@ cp "$work/v/a.vdb.json" "$work/v/b.vdb.json"
 grep -q "a.vdb: ok, " "$work/out" || fail "verify: $(cat "$work/out")"
 grep -q "b.vdb: refused: .*bytes, the manifest says" "$work/out" || fail "verify: $(cat "$work/out")"
 grep -q "1 of 2 files read whole" "$work/err" || fail "verify: $(cat "$work/err")"
+# Without its manifest a bake is read from its metadata, and said to be unverified.
+rm "$work/v/b.vdb" "$work/v/b.vdb.json" "$work/v/a.vdb.json"
+"$tool" verify "$work/v/a.vdb" >"$work/out" 2>"$work/err" || fail "verify without a manifest: $(cat "$work/out")"
+grep -q "a.vdb: unverified, .*no manifest 'a.vdb.json'" "$work/out" || fail "verify: $(cat "$work/out")"
 rm -r "$work/v"
 
-# One tree: the .vdb and its manifest; one summary line.
+# One tree: the .vdb, its manifest and its branch mesh; one summary line.
 "$bake" tree "$bough" --tree 0 --voxel-size 0.5 --out "$work/b.vdb" 2>"$work/err" \
     || fail "bake tree of bough.json failed: $(tail -1 "$work/err")"
-for f in b.vdb b.vdb.json; do [ -s "$work/$f" ] || fail "missing output $f"; done
+for f in b.vdb b.vdb.json b.obj; do [ -s "$work/$f" ] || fail "missing output $f"; done
 [ "$(wc -l <"$work/err")" -eq 1 ] || fail "bake tree: stderr is not one line: $(cat "$work/err")"
-grep -q "1 trees, [1-9][0-9]* voxels, [1-9][0-9]* bytes" "$work/err" || fail "no summary line: $(cat "$work/err")"
+grep -q "1 tree, [1-9][0-9]* voxels, [1-9][0-9]* bytes" "$work/err" || fail "no summary line: $(cat "$work/err")"
 grep -q '"fnv1a64"' "$work/b.vdb.json" || fail "manifest lacks fnv1a64"
 
 # All trees of a scene, in parallel: tree_000.vdb ... and a summary line last.
 mkdir "$work/forest"
 "$bake" scene "$src/scenes/three-firs.json" --voxel-size 2 --levels 2 --out-dir "$work/forest" 2>"$work/err" \
     || fail "bake scene of three-firs.json failed: $(tail -1 "$work/err")"
-for f in tree_000.vdb tree_000.vdb.json tree_002.vdb tree_002.vdb.json; do
+for f in tree_000.vdb tree_000.vdb.json tree_000.obj tree_002.vdb tree_002.vdb.json instances.json; do
     [ -s "$work/forest/$f" ] || fail "missing output forest/$f"
 done
 [ "$(ls -A "$work/forest" | grep -c '\.vdb$')" -eq 3 ] || fail "expected 3 trees: $(ls -A "$work/forest")"
-[ -z "$(ls -A "$work/forest" | grep -v -e '\.vdb$' -e '\.vdb\.json$')" ] || fail "temporary files left: $(ls -A "$work/forest")"
+[ -z "$(ls -A "$work/forest" | grep -v -e '\.vdb$' -e '\.vdb\.json$' -e '\.obj$' -e '^instances\.json$')" ] \
+    || fail "temporary files left: $(ls -A "$work/forest")"
+/usr/bin/python3 - "$work/forest/instances.json" <<'EOF2' || fail "instances.json does not list the three trees"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["format"] == "pine-instances" and j["units"] == "m", j
+assert [i["grids"] for i in j["instances"]] == ["tree_000.vdb", "tree_001.vdb", "tree_002.vdb"], j
+assert all(i["mesh"].endswith(".obj") and len(i["tree_to_world"]) == 4 for i in j["instances"]), j
+EOF2
 tail -1 "$work/err" | grep -q "3 trees, .* voxels, .* bytes, .* s, peak .* MiB" || fail "no summary line: $(tail -1 "$work/err")"
 if command -v vdb_print >/dev/null; then
-    vdb_print "$work/forest/tree_001.vdb" | grep -q "density_lod1" || fail "vdb_print lacks density_lod1"
+    vdb_print "$work/forest/tree_001.vdb" | grep -q "density_level_1" || fail "vdb_print lacks density_level_1"
 fi
 
 "$bake" --help >/dev/null || fail "--help"

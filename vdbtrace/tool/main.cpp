@@ -128,6 +128,26 @@ std::string describe(const scenes::Scene& scene, const vdbtrace::TracedScene& tr
            counted(branches, "branch", "branches") + ", " + counted(needles, "needle", "needles");
 }
 
+/// Refuses grids baked from a tree this scene does not hold (another scene's, or this one's
+/// before it changed): the files record which tree they are and a digest of its boughs.
+void checkBakedFrom(const fs::path& file, const bake::BakeProvenance& from, const Loaded& loaded,
+                    const fs::path& sceneFile)
+{
+    if (from.treeDigest.empty()) return;  // a grid from elsewhere, already warned of
+    const auto& trees = loaded.traced.trees;
+    const std::string origin = "'" + file.string() + "' was baked from tree " +
+                               std::to_string(from.tree) + " of '" + from.scene + "'";
+    if (from.tree < 0 || std::size_t(from.tree) >= trees.size()) {
+        throw InputError(origin + ", which '" + sceneFile.string() + "' does not have (it has " +
+                         std::to_string(trees.size()) + "): bake this scene");
+    }
+    if (bake::treeDigest(bake::treeBoughs(trees[std::size_t(from.tree)])) != from.treeDigest) {
+        throw InputError(origin + ", whose boughs differ from those of tree " +
+                         std::to_string(from.tree) + " of '" + sceneFile.string() +
+                         "': bake this scene");
+    }
+}
+
 fs::path besideWith(const fs::path& image, const std::string& suffix)
 {
     fs::path p = image;
@@ -161,15 +181,20 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                           inputs);
     // Baked files first: a damaged one is refused before any work.
     std::optional<bake::TreeGrids> baked;
+    std::vector<bake::BakeProvenance> bakedFrom;
     if (methodName == "reference" && !gridFiles.empty()) {
         std::vector<bake::TreeGrids> trees;
         for (const fs::path& file : gridFiles) {
-            trees.push_back(bake::readTreeGrids(file, bake::memoryLimit(maxMemoryGiB)));
+            bake::ReadGrids read = bake::readTreeGrids(file, bake::memoryLimit(maxMemoryGiB));
+            if (!read.unverified.empty()) {
+                std::cerr << "vdbtrace: warning: '" << file.string() << "': " << read.unverified
+                          << '\n';
+            }
+            trees.push_back(std::move(read.grids));
+            bakedFrom.push_back(std::move(read.provenance));
         }
-        baked = bake::mergeTreeGrids(trees);  // files bake wrote, checked against manifests
+        baked = bake::mergeTreeGrids(trees);  // checked against manifests or their metadata
         settings.grids = &*baked;
-        std::cerr << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "
-                  << baked->voxelSize_cm << " cm read\n";
     }
     const auto loaded = load(sceneFile, model, [&](const scenes::Scene& scene) {
         const double voxelsRead = baked ? double(baked->layerOpacity->activeVoxelCount()) : 0.0;
@@ -177,6 +202,13 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             bake::estimateRender(scene, methodName, settings.voxelSize_cm, voxelsRead),
             bake::memoryLimit(maxMemoryGiB), sceneFile.string());
     });
+    for (std::size_t i = 0; i < bakedFrom.size(); ++i) {
+        checkBakedFrom(gridFiles[i], bakedFrom[i], *loaded, sceneFile);
+    }
+    if (baked) {
+        std::cerr << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "
+                  << baked->voxelSize_cm << " cm read\n";
+    }
     std::cerr << "vdbtrace: " << sceneFile.string() << ": "
               << describe(loaded->scene, loaded->traced) << '\n';
     settings.geometry.built = [](const vdbtrace::GeometryBuild& b) {

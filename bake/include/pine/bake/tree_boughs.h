@@ -4,6 +4,7 @@
 #include "pine/bake/layer_field.h"
 #include "pine/bake/tree_grids.h"
 
+#include <string>
 #include <vector>
 
 namespace pine::scenes {
@@ -22,6 +23,10 @@ analytic::BoughGeometry boughGeometry(const scenes::NeedleParameters& p);
 /// slowly along a branch, section 3.1), albedo scenes::needleColour. The tracer prepares its
 /// boughs from the same list.
 std::vector<BoughSpec> treeBoughs(const scenes::Tree& tree);
+
+/// A digest of the boughs (their ends, needle parameters and albedo, FNV-1a 64 in 16 hex
+/// digits): bake records it in each file, and a render refuses grids of another tree.
+std::string treeDigest(const std::vector<BoughSpec>& boughs);
 
 /// The boughs of all `trees` in one set of grids, the trees' boughs in order: what the
 /// reference method renders a whole scene through (bake tree/scene write one file a tree).

@@ -9,6 +9,7 @@
 #include <openvdb/openvdb.h>
 
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -46,38 +47,40 @@ struct FieldInfo {
 /// The table bake, write, read and merge loop over.
 inline constexpr FieldInfo kFields[] = {
     {Field::Density, "density", false, openvdb::VEC_INVARIANT,
-     "mean extinction / pine:density_scale_per_cm, in [0, 1] (fog volume)"},
+     "mean extinction over directions, per world unit (pine:units)"},
     {Field::LayerGradient, "layer_gradient", true, openvdb::VEC_COVARIANT,
-     "G = grad g / dh, layers crossed per cm along each axis"},
+     "G = grad g / dh, layers crossed per world unit along each axis"},
     {Field::LayerOpacity, "layer_opacity", false, openvdb::VEC_INVARIANT,
      "A = 2 N r / (pi R), the opacity of one layer"},
     {Field::NeedleDirection, "needle_direction", true, openvdb::VEC_CONTRAVARIANT_RELATIVE,
      "unit needle direction, cos(phi) axis + sin(phi) radial"},
     {Field::NeedleCoverage, "needle_coverage", false, openvdb::VEC_INVARIANT,
      "min(1, N r / (pi rho)): the needles' coverage of their cone there (fibre law)"},
-    {Field::NeedleAlbedo, "needle_albedo", true, openvdb::VEC_INVARIANT,
-     "needle albedo, linear RGB"},
+    {Field::NeedleAlbedo, "color", true, openvdb::VEC_INVARIANT,
+     "needle albedo, linear RGB (Blender's color, Houdini's Cd)"},
 };
 
-/// The name of density pyramid level `level` >= 1 ("density_lod1", ...).
+/// The name of density pyramid level `level` >= 1, as vdb_lod names its levels
+/// ("density_level_1", ...).
 inline std::string densityLodName(int level)
 {
-    return std::string(kFields[0].name) + "_lod" + std::to_string(level);
+    return std::string(kFields[0].name) + "_level_" + std::to_string(level);
 }
 
 /// The layout of what writeTreeGrids writes (pine:format_version); readTreeGrids refuses
-/// another. 2: the first with a version and an extinction law by name; 3: needle_coverage.
-inline constexpr int kFormatVersion = 3;
+/// another. 2: the first with a version and an extinction law by name; 3: needle_coverage;
+/// 4: density as extinction per world unit, `color`, vdb_lod's level names, units and frames.
+inline constexpr int kFormatVersion = 4;
 
 struct BakeSettings {
     double voxelSize_cm = 0.5;
-    int pyramidLevels = 3;  ///< density at voxel sizes h, 2h, 4h, ...: "density_lod1", ...
+    int pyramidLevels = 3;  ///< density at voxel sizes h, 2h, 4h, ...: "density_level_1", ...
     std::string extinctionLaw = "fibre";  ///< a name of extinctionLawNames()
 };
 
 /// A tree's grids in world space (cm), all on one transform of voxel size h, voxels sampled at
 /// their centres. Where several boughs overlap a voxel keeps the one of largest mean
-/// extinction. density = meanExtinction / densityScale_per_cm, so in [0, 1].
+/// extinction; density is that mean extinction, per cm.
 struct TreeGrids {
     openvdb::FloatGrid::Ptr density;
     openvdb::Vec3SGrid::Ptr layerGradient;
@@ -88,7 +91,6 @@ struct TreeGrids {
     /// Coarser densities, lod 1, 2, ...: lod k has voxels of 2^k h, each the mean of its 8
     /// children, centred on their mean centre (its own transform, shifted by (2^k - 1) h / 2).
     std::vector<openvdb::FloatGrid::Ptr> densityPyramid;
-    double densityScale_per_cm = 0.0;  ///< extinction per cm of density 1
     double voxelSize_cm = 0.5;
     std::string extinctionLaw = "fibre";  ///< the law density was made with, and sigma's
 
@@ -110,26 +112,65 @@ struct BakeProvenance {
     std::string scene;
     int tree = -1;
     unsigned seed = 0;
+    /// treeDigest of the boughs baked: a render refuses grids of another tree (empty: unknown).
+    std::string treeDigest;
+};
+
+/// A length unit of a file's world space (pine:units): Blender and Houdini scenes are in
+/// metres, the scene format in cm.
+enum class LengthUnit { Centimetre, Metre };
+
+/// "cm" or "m"; lengthUnit throws BakeError for another name.
+const char* unitName(LengthUnit unit);
+LengthUnit lengthUnit(const std::string& name);
+inline double centimetresPer(LengthUnit unit) { return unit == LengthUnit::Metre ? 100.0 : 1.0; }
+
+/// Where a tree stands in its scene: the origin of its own frame at its base, and its rotation
+/// about z (scenes::TreePlacement).
+struct TreeFrame {
+    Vec3 base_cm{0.0};
+    double rotation_rad = 0.0;
+};
+
+/// How a file lays out the grids: its unit and frame. In the tree's frame the grids' transform
+/// maps the scene's voxel lattice into the tree's frame (so a tool finds the tree at its origin,
+/// upright, and a render maps it back onto the scene's lattice voxel for voxel), vectors turned
+/// with it; lengths, extinction and layers per length in `unit`.
+struct FileLayout {
+    LengthUnit unit = LengthUnit::Metre;
+    std::optional<TreeFrame> treeFrame;  ///< empty: the scene's world frame
 };
 
 /// Writes the grids atomically (temporary file in the same folder, synced, then renamed) with
-/// file metadata (format version, units, extinction law and its formula, voxel size, scene,
-/// tree, seed, tool version) and a manifest `PATH.json` beside it recording the file's size
-/// and checksum, put in place before the grid (accepting the grid it replaces too, until the
-/// grid is renamed): if writing either fails or the bake is killed, a grid under its final name
-/// matches its manifest. Runs writing into one folder take turns (io::FolderLock). Removes the
-/// temporaries of a killed earlier write first. Throws BakeError.
+/// file metadata (format version, units, frame, extinction law and its formula, voxel size,
+/// scene, tree, seed, tree digest, tool version) and a manifest `PATH.json` beside it recording
+/// the file's size and checksum, put in place before the grid (accepting the grid it replaces
+/// too, until the grid is renamed): if writing either fails or the bake is killed, a grid under
+/// its final name matches its manifest. Runs writing into one folder take turns
+/// (io::FolderLock). Removes the temporaries of a killed earlier write first. Throws BakeError.
 void writeTreeGrids(const TreeGrids& grids, const std::filesystem::path& path,
-                    const BakeProvenance& provenance);
+                    const BakeProvenance& provenance, const FileLayout& layout = {});
 
-/// Reads grids written by writeTreeGrids, after checking the manifest's size and checksum:
-/// a damaged or foreign file is refused with BakeError, never opened by OpenVDB. Refuses a file
-/// of another format version or of an extinction law not registered here. Also catches what
-/// OpenVDB throws. A file whose manifest matches (edited or produced elsewhere) is parsed first
-/// in a child process with at most `maxMemoryBytes` (0: defaultMemoryLimit()), 1 GiB plus 256
-/// times the file's size and 10 s plus 1 s per 2 MB: where OpenVDB crashes, hangs or runs out of
-/// memory on it, BakeError says so. Call it before parallel work.
-TreeGrids readTreeGrids(const std::filesystem::path& path, double maxMemoryBytes = 0.0);
+/// What readTreeGrids found: the grids in the scene's world space (cm), what made them, and
+/// whether a manifest vouched for the bytes.
+struct ReadGrids {
+    TreeGrids grids;
+    BakeProvenance provenance;
+    /// Empty when a manifest matched; else why the grids are unverified (read from their
+    /// metadata alone: a grid made or edited in another tool).
+    std::string unverified;
+};
+
+/// Reads grids written by writeTreeGrids, back in the scene's world space in cm whatever their
+/// unit and frame. With a manifest beside it, the file must match its size and checksum
+/// (a damaged file is refused with BakeError, never opened by OpenVDB); without one, it is
+/// read if its metadata says what it holds (format version, units, frame, extinction law) and
+/// marked unverified, else refused. Refuses a file of another format version, of an extinction
+/// law not registered here, or missing a field. Also catches what OpenVDB throws. The bytes are
+/// parsed first in a child process with at most `maxMemoryBytes` (0: defaultMemoryLimit()),
+/// 1 GiB plus 256 times the file's size and 10 s plus 1 s per 2 MB: where OpenVDB crashes,
+/// hangs or runs out of memory on them, BakeError says so. Call it before parallel work.
+ReadGrids readTreeGrids(const std::filesystem::path& path, double maxMemoryBytes = 0.0);
 
 }  // namespace pine::bake
 
@@ -137,7 +178,7 @@ namespace pine::bake {
 
 /// The grids of several trees as one set (what a renderer marches through): all must share a
 /// voxel size (BakeError otherwise); where two overlap, the first keeps the voxel, as within a
-/// tree. The density pyramid is not merged; density keeps the largest scale of the inputs.
+/// tree. The density pyramid is not merged.
 TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees);
 
 }  // namespace pine::bake
