@@ -3,6 +3,7 @@
 #include "pine/support/atomic_file.h"
 #include "pine/support/plot_script.h"
 #include "pine/support/progress.h"
+#include "pine/support/tool_main.h"
 
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/cone_shader.h"
@@ -241,11 +242,11 @@ int runSweep(const SweepOptions& opt)
     io::checkWritableFolder(opt.outDir);  // before the work
 
     nlohmann::json summary;
-    std::cerr << "analytic sweep: F fit\n";
+    pine::tool::info() << "analytic sweep: F fit\n";
     summary["F_fit"] = sweepFFit(opt.outDir);
-    std::cerr << "analytic sweep: cone fits (" << opt.coneCases << " cases)\n";
+    pine::tool::info() << "analytic sweep: cone fits (" << opt.coneCases << " cases)\n";
     summary["cone_fits"] = sweepConeFits(opt.outDir, opt);
-    std::cerr << "analytic sweep: linear law against exact transmittance\n";
+    pine::tool::info() << "analytic sweep: linear law against exact transmittance\n";
     summary["linear_law"] = sweepLinearLaw(opt.outDir);
     io::writeTextAtomically(opt.outDir / "summary.json", summary.dump(2) + "\n");
 
@@ -258,7 +259,7 @@ int runSweep(const SweepOptions& opt)
     }
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     const auto& paper = summary["linear_law"]["paper_bough"];
-    std::cerr << "analytic sweep: done in " << seconds << " s -> " << opt.outDir.string()
+    pine::tool::info() << "analytic sweep: done in " << seconds << " s -> " << opt.outDir.string()
               << " | F fit max error " << summary["F_fit"]["max_abs_error"].get<double>()
               << " | paper bough nA " << paper["nA"].get<double>() << ": linear law alpha "
               << paper["alpha_linear_unclamped"].get<double>() << " vs exact "

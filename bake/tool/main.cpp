@@ -74,6 +74,7 @@ void summarize(const Totals& totals, std::chrono::steady_clock::time_point start
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const std::size_t trees = totals.trees.load();
+    if (tool::quiet()) return;
     std::fprintf(stderr, "bake: %zu %s, %llu voxels, %llu bytes, %.2f s, peak %.0f MiB\n",
                  trees, trees == 1 ? "tree" : "trees", static_cast<unsigned long long>(totals.voxels.load()),
                  static_cast<unsigned long long>(totals.bytes.load()), seconds,

@@ -14,6 +14,14 @@ namespace pine::tool {
 std::filesystem::path plotScript(const std::string& name)
 {
     if (const char* env = std::getenv("PINE_PLOT_SCRIPT")) return env;
+    // Installed (cmake --install): beside the executable's bin/, in share/pine/.
+    std::error_code error;
+    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+    if (!error) {
+        const std::filesystem::path installed =
+            self.parent_path().parent_path() / PINE_INSTALL_DATADIR / name;
+        if (std::filesystem::is_regular_file(installed, error)) return installed;
+    }
     return std::filesystem::path(PINE_SOURCE_DIR) / "scripts" / name;
 }
 

@@ -1,5 +1,7 @@
 #include "pine/support/progress.h"
 
+#include "pine/support/tool_main.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -37,7 +39,7 @@ void Progress::show(double fraction, const std::string& text)
     if (!(fraction >= 0.0)) fraction = 0.0;  // NaN too
     fraction = std::min(fraction, 1.0);
     const std::lock_guard<std::mutex> lock(mMutex);
-    if (mFinished || fraction <= mShown) return;
+    if (mFinished || fraction <= mShown || quiet()) return;
     mShown = fraction;
     if (mTerminal) {
         std::fprintf(stderr, "\r%s %s", mWhat.c_str(), text.c_str());

@@ -15,6 +15,14 @@
 namespace pine::tool {
 namespace {
 
+bool gQuiet = false;
+
+// Where informational lines go under --quiet.
+class NullBuffer : public std::streambuf {
+protected:
+    int overflow(int c) override { return traits_type::not_eof(c); }
+};
+
 // What an error says, on one line: a library's message may span several.
 std::string oneLine(std::string text)
 {
@@ -33,6 +41,7 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
     int threads = 0;
     app.add_option("--threads", threads, "Worker threads (default: all cores)")
         ->check(CLI::NonNegativeNumber);
+    app.add_flag("--quiet,-q", gQuiet, "Only warnings and errors on stderr (no progress)");
     app.set_version_flag("--version", std::string(name) + " " + PINE_TOOL_VERSION);
     for (CLI::App* sub : app.get_subcommands({})) {
         sub->fallthrough();  // --threads and --version also after the subcommand
@@ -66,6 +75,15 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
         std::cerr << name << ": " << oneLine(e.what()) << '\n';
         return 1;
     }
+}
+
+bool quiet() { return gQuiet; }
+
+std::ostream& info()
+{
+    static NullBuffer nothing;
+    static std::ostream discard(&nothing);
+    return gQuiet ? discard : std::cerr;
 }
 
 CLI::Validator positiveNumber()

@@ -80,9 +80,48 @@ echo keep >"$work/keep.exr"
 for f in b.exr b.png b.level.png b.json; do [ -s "$work/$f" ] || fail "missing output $f"; done
 tail -1 "$work/err" | grep -q "cone rays" || fail "no summary line: $(tail -1 "$work/err")"
 grep -q '"shadow_rays"' "$work/b.json" || fail "stats lack shadow_rays"
-if command -v oiiotool >/dev/null; then
-    oiiotool --info -v "$work/b.exr" | grep -q "level.Y" || fail "EXR lacks the level AOV"
-fi
+# The EXR as compositors and pbrt-v4 read it: Z (infinite where nothing is hit), only the AOVs
+# the method computes, typed render time, samples and camera matrices.
+exr_info() { oiiotool --info -v "$1" 2>&1; }
+exr_info "$work/b.exr" >"$work/info"
+grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, level.Y, specular.Y, tree.Y" "$work/info" \
+    || fail "multiscale EXR channels: $(grep 'channel list' "$work/info")"
+grep -q "samplesPerPixel: 1$" "$work/info" || fail "multiscale EXR lacks samplesPerPixel 1"
+grep -q "renderTimeSeconds: [0-9.e-]*$" "$work/info" || fail "EXR lacks a float renderTimeSeconds"
+grep -q "worldToCamera: " "$work/info" && grep -q "worldToNDC: " "$work/info" || fail "EXR lacks camera matrices"
+grep -q 'pine:needle_level_max: 0.25$' "$work/info" || fail "level thresholds not typed: $(grep level_max "$work/info")"
+oiiotool "$work/b.exr" --ch A --printstats 2>&1 | grep -q "Stats Min: 0.0* (float)" || fail "bough.json should leave background"
+# Where alpha is 0 nothing is hit: Z is +inf there (oiiotool counts it as an Inf pixel).
+oiiotool "$work/b.exr" --ch Z --printstats 2>&1 | grep -q "InfCount: [1-9]" || fail "Z is not infinite where nothing is hit"
+"$vdbtrace" render "$src/scenes/bough.json" --method geometry --samples 2 --out "$work/g.exr" 2>/dev/null \
+    || fail "geometry render failed"
+exr_info "$work/g.exr" >"$work/info"
+grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, specular.Y, tree.Y$" "$work/info" \
+    || fail "geometry EXR channels: $(grep 'channel list' "$work/info")"
+grep -q "samplesPerPixel: 2$" "$work/info" || fail "geometry EXR lacks samplesPerPixel 2"
+# A crop is the whole frame's pixels, as the EXR's data window; --resolution keeps the view;
+# --quiet leaves stderr empty on success.
+for m in multiscale geometry; do
+    "$vdbtrace" render "$src/scenes/bough.json" --method $m --resolution 64x48 --out "$work/full.exr" --quiet 2>"$work/err" \
+        || fail "render --resolution ($m): $(cat "$work/err")"
+    [ -s "$work/err" ] && fail "--quiet wrote to stderr: $(cat "$work/err")"
+    "$vdbtrace" render "$src/scenes/bough.json" --method $m --resolution 64x48 --crop 10,5,50,40 --out "$work/crop.exr" -q 2>/dev/null \
+        || fail "render --crop ($m) failed"
+    oiiotool --info -v "$work/crop.exr" >"$work/info"
+    grep -q "40 x   35" "$work/info" && grep -q "pixel data origin: x=10, y=5" "$work/info" \
+        && grep -q "full/display size: 64 x 48" "$work/info" || fail "crop window: $(cat "$work/info")"
+    oiiotool "$work/full.exr" --crop 40x35+10+5 -o "$work/full-crop.exr"
+    idiff -q -fail 0 -failpercent 0 "$work/full-crop.exr" "$work/crop.exr" >/dev/null 2>&1 \
+        || fail "the crop ($m) differs from the frame's pixels: $(idiff "$work/full-crop.exr" "$work/crop.exr" | tail -2)"
+done
+oiiotool --info "$work/full.exr" | grep -q "64 x   48" || fail "--resolution not applied: $(oiiotool --info "$work/full.exr")"
+expect_error "crop outside the frame" 2 "crop 0,0,100,10 reaches outside the 64 x 48 frame" -- \
+    render "$src/scenes/bough.json" --resolution 64x48 --crop 0,0,100,10 --out "$work/c.exr"
+expect_error "crop backwards" 2 "crop" -- render "$src/scenes/bough.json" --crop 10,10,5,20 --out "$work/c.exr"
+expect_error "bad resolution" 2 "resolution" -- render "$src/scenes/bough.json" --resolution 0x10 --out "$work/c.exr"
+[ -e "$work/c.exr" ] && fail "a refused crop wrote an image"
+expect_error "level image of a method without levels" 2 "--aov level: method 'geometry' has no levels" -- \
+    render "$src/scenes/bough.json" --method geometry --aov level --out "$work/g2.exr"
 
 # The models: faithful by default, --paper as printed, recorded in the stats; a scene naming an
 # unknown one is refused with its key.
@@ -117,6 +156,8 @@ if [ -x "$bake" ]; then
     "$vdbtrace" render "$src/scenes/bough.json" --method reference --grids "$work/t.vdb" \
         --subpixels 1 --out "$work/r.exr" 2>"$work/err" || fail "reference from grids: $(tail -1 "$work/err")"
     [ -s "$work/r.exr" ] || fail "reference wrote no image"
+    oiiotool --info -v "$work/r.exr" | grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, specular.Y$" \
+        || fail "reference EXR channels: $(oiiotool --info -v "$work/r.exr" | grep 'channel list')"
     head -c 1000 "$work/t.vdb" >"$work/cut.vdb" && cp "$work/t.vdb.json" "$work/cut.vdb.json"
     expect_error "damaged grids" 2 "manifest" -- render "$src/scenes/bough.json" --method reference \
         --grids "$work/cut.vdb" --out "$work/d.exr"

@@ -103,11 +103,12 @@ Image sampleImage()
     image.rgba[5] = -3.5e7f;
     image.rgba[6] = std::numeric_limits<float>::denorm_min();
     auto& level = image.aov("level");
-    auto& depth = image.aov("depth");
+    auto& depth = image.aov("Z");
     for (std::size_t i = 0; i < level.size(); ++i) {
         level[i] = 1.0f + float(i) / 7.0f;
         depth[i] = float(i) * 123.456f;
     }
+    depth[3] = std::numeric_limits<float>::infinity();  // nothing hit
     return image;
 }
 
@@ -125,9 +126,15 @@ void expectBitExact(const std::vector<float>& expected, const std::vector<float>
 TEST_F(ImageIo, ExrRoundTripIsBitExact)
 {
     const Image image = sampleImage();
+    pine::vdbtrace::Matrix44 camera;
+    for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) camera.m[i][j] = float(i * 4 + j) * 0.5f - 3.0f;
+    }
     const Metadata metadata = {{"scene", "paper-fig12.json"},
                                {"method", "multiscale"},
-                               {"renderTime_s", "12.5"},
+                               {"renderTimeSeconds", 12.5f},
+                               {"samplesPerPixel", 16},
+                               {"worldToCamera", camera},
                                {"settings", std::string(300, 'x') + " with spaces, ümlauts"}};
     const fs::path path = dir / "frame.exr";
     pine::vdbtrace::writeExr(image, path, metadata);
@@ -138,13 +145,19 @@ TEST_F(ImageIo, ExrRoundTripIsBitExact)
     EXPECT_EQ(read.height, 3);
     expectBitExact(image.rgba, read.rgba, "rgba");
     ASSERT_EQ(read.aovs.size(), 2u);
-    ASSERT_TRUE(read.aovs.count("level") && read.aovs.count("depth"));
+    ASSERT_TRUE(read.aovs.count("level") && read.aovs.count("Z"));
     expectBitExact(image.aovs.at("level"), read.aovs.at("level"), "level");
-    expectBitExact(image.aovs.at("depth"), read.aovs.at("depth"), "depth");
+    expectBitExact(image.aovs.at("Z"), read.aovs.at("Z"), "Z");
 
+    // Each value comes back with its type.
     Metadata expected = metadata;
-    std::sort(expected.begin(), expected.end());
-    EXPECT_EQ(back, expected);
+    std::sort(expected.begin(), expected.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    ASSERT_EQ(back.size(), expected.size());
+    for (std::size_t i = 0; i < back.size(); ++i) {
+        EXPECT_EQ(back[i].first, expected[i].first);
+        EXPECT_TRUE(back[i].second == expected[i].second) << back[i].first;
+    }
     EXPECT_EQ(listing(), std::vector<std::string>{"frame.exr"});
 }
 
@@ -163,7 +176,7 @@ TEST_F(ImageIo, ExrIsFloatZipWithAovLayers)
     EXPECT_EQ(std::vector<std::string>(names.begin(), names.begin() + 4),
               (std::vector<std::string>{"R", "G", "B", "A"}));
     std::sort(names.begin() + 4, names.end());
-    EXPECT_EQ(names[4], "depth.Y");
+    EXPECT_EQ(names[4], "Z");  // OpenEXR's depth channel, under its own name
     EXPECT_EQ(names[5], "level.Y");
 }
 
@@ -180,7 +193,7 @@ TEST_F(ImageIo, OiiotoolListsAovChannelsAndMetadata)
     ASSERT_EQ(std::system(command.c_str()), 0) << slurp(info);
     const std::string text = slurp(info);
     EXPECT_NE(text.find("level.Y"), std::string::npos) << text;
-    EXPECT_NE(text.find("depth.Y"), std::string::npos) << text;
+    EXPECT_NE(text.find("channel list: R, G, B, A, Z, level.Y"), std::string::npos) << text;
     EXPECT_NE(text.find("method: \"reference\""), std::string::npos) << text;
 }
 
@@ -313,6 +326,9 @@ TEST_F(ImageIo, FailedWriteKeepsTheExistingFile)
     EXPECT_THROW(pine::vdbtrace::writeExr(sampleImage(), exr, {{"compression", "none"}}),
                  ImageError);
     EXPECT_THROW(pine::vdbtrace::writeExr(sampleImage(), exr, {{"a", "1"}, {"a", "2"}}),
+                 ImageError);
+    // A camera matrix only as a matrix.
+    EXPECT_THROW(pine::vdbtrace::writeExr(sampleImage(), exr, {{"worldToCamera", "identity"}}),
                  ImageError);
     EXPECT_THROW(pine::vdbtrace::writeLevelPng(Image(5, 3), png), ImageError);
 

@@ -32,4 +32,33 @@ ConeRay ConeCamera::coneAt(double px, double py, double pixels) const
     return ray;
 }
 
+std::array<std::array<double, 4>, 4> ConeCamera::worldToCamera() const
+{
+    std::array<std::array<double, 4>, 4> m{};
+    const Vec3* rows[3] = {&mRight, &mUp, &mForward};
+    for (int i = 0; i < 3; ++i) {
+        const Vec3& r = *rows[i];
+        m[i] = {r.x, r.y, r.z, -glm::dot(r, mEye)};
+    }
+    m[3] = {0.0, 0.0, 0.0, 1.0};
+    return m;
+}
+
+std::array<std::array<double, 4>, 4> ConeCamera::worldToNdc() const
+{
+    // coneAt's image position: px / width = 1/2 + x / (2 z tan(fov/2) aspect), py / height =
+    // 1/2 - y / (2 z tan(fov/2)), with (x, y, z) in camera space.
+    const double sx = 0.5 / (mTanHalf * mAspect), sy = 0.5 / mTanHalf;
+    const double ndcFromCamera[4][4] = {
+        {sx, 0.0, 0.5, 0.0}, {0.0, -sy, 0.5, 0.0}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}};
+    const auto camera = worldToCamera();
+    std::array<std::array<double, 4>, 4> m{};
+    for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) {
+            for (int k = 0; k < 4; ++k) m[i][j] += ndcFromCamera[i][k] * camera[k][j];
+        }
+    }
+    return m;
+}
+
 }  // namespace pine::vdbtrace

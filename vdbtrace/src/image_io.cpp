@@ -23,8 +23,17 @@ namespace {
 namespace fs = std::filesystem;
 
 // An AOV's channel is "<aov>.Y": viewers (and OpenEXR's layer convention) show each AOV as a
-// single-channel layer.
+// single-channel layer. Z, OpenEXR's depth, keeps its bare name, which compositors look for.
 constexpr std::string_view kAovSuffix = ".Y";
+constexpr std::string_view kDepthChannel = "Z";
+
+std::string channelOf(const std::string& aov)
+{
+    return aov == kDepthChannel ? aov : aov + std::string(kAovSuffix);
+}
+
+// Camera matrices, stored as pbrt-v4 stores them (m44f).
+bool isCameraMatrix(std::string_view key) { return key == "worldToCamera" || key == "worldToNDC"; }
 
 // OIIO error text may span lines; our errors are one line.
 std::string oneLine(std::string text)
@@ -190,23 +199,37 @@ void writeExr(const Image& image, const std::filesystem::path& path, const Metad
     const int channels = 4 + int(image.aovs.size());
     OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::FLOAT);
     spec.channelnames = {"R", "G", "B", "A"};
-    for (const auto& entry : image.aovs) {
-        spec.channelnames.push_back(entry.first + std::string(kAovSuffix));
-    }
+    for (const auto& entry : image.aovs) spec.channelnames.push_back(channelOf(entry.first));
     spec.alpha_channel = 3;
+    if (image.frameWidth > 0 && image.frameHeight > 0) {
+        spec.x = image.originX;
+        spec.y = image.originY;
+        spec.full_width = image.frameWidth;
+        spec.full_height = image.frameHeight;
+    }
     spec.attribute("compression", "zip");  // lossless: float values come back bit-exact
     for (std::size_t i = 0; i < metadata.size(); ++i) {
         const auto& [key, value] = metadata[i];
         if (key.empty()) fail(what, path, "a metadata key is empty");
-        if (isReservedKey(key)) {
-            fail(what, path, "metadata key '" + key + "' is reserved by OpenEXR/OpenImageIO");
+        const Matrix44* matrix = std::get_if<Matrix44>(&value);
+        if (isCameraMatrix(key) ? !matrix : isReservedKey(key)) {
+            fail(what, path, "metadata key '" + key + "' is reserved by OpenEXR/OpenImageIO" +
+                                 (isCameraMatrix(key) ? " for a matrix" : ""));
         }
         for (std::size_t j = 0; j < i; ++j) {
             if (metadata[j].first == key) {
                 fail(what, path, "metadata key '" + key + "' is given twice");
             }
         }
-        spec.attribute(key, value);
+        if (const auto* text = std::get_if<std::string>(&value)) {
+            spec.attribute(key, *text);
+        } else if (const auto* number = std::get_if<int>(&value)) {
+            spec.attribute(key, *number);
+        } else if (const auto* real = std::get_if<float>(&value)) {
+            spec.attribute(key, *real);
+        } else {
+            spec.attribute(key, OIIO::TypeDesc::TypeMatrix44, &matrix->m[0][0]);
+        }
     }
 
     const std::size_t pixels = std::size_t(image.width) * std::size_t(image.height);
@@ -293,6 +316,13 @@ Image readExr(const std::filesystem::path& path, Metadata* metadata)
     }
 
     Image image(spec.width, spec.height);
+    if (spec.x != 0 || spec.y != 0 || spec.full_width != spec.width ||
+        spec.full_height != spec.height) {
+        image.originX = spec.x;
+        image.originY = spec.y;
+        image.frameWidth = spec.full_width;
+        image.frameHeight = spec.full_height;
+    }
     for (std::size_t p = 0; p < pixels; ++p) {
         const float* src = &interleaved[p * std::size_t(channels)];
         for (int c = 0; c < 4; ++c) {
@@ -302,8 +332,10 @@ Image readExr(const std::filesystem::path& path, Metadata* metadata)
     }
     for (int c = 0; c < channels; ++c) {
         const std::string& name = spec.channelnames[c];
-        if (name.size() <= kAovSuffix.size() || !name.ends_with(kAovSuffix)) continue;
-        std::vector<float>& values = image.aov(name.substr(0, name.size() - kAovSuffix.size()));
+        const bool suffixed = name.size() > kAovSuffix.size() && name.ends_with(kAovSuffix);
+        if (!suffixed && name != kDepthChannel) continue;
+        std::vector<float>& values =
+            image.aov(suffixed ? name.substr(0, name.size() - kAovSuffix.size()) : name);
         for (std::size_t p = 0; p < pixels; ++p) {
             values[p] = interleaved[p * std::size_t(channels) + c];
         }
@@ -313,11 +345,25 @@ Image readExr(const std::filesystem::path& path, Metadata* metadata)
         metadata->clear();
         for (const auto& attribute : spec.extra_attribs) {
             const std::string key = attribute.name().string();
-            if (attribute.type() != OIIO::TypeDesc::STRING || isStandardAttribute(key)) continue;
-            metadata->emplace_back(key, attribute.get_string());
+            const OIIO::TypeDesc type = attribute.type();
+            if (isCameraMatrix(key) && type == OIIO::TypeDesc::TypeMatrix44) {
+                Matrix44 matrix;
+                std::copy_n(static_cast<const float*>(attribute.data()), 16, &matrix.m[0][0]);
+                metadata->emplace_back(key, matrix);
+                continue;
+            }
+            if (isStandardAttribute(key) || isReservedKey(key)) continue;
+            if (type == OIIO::TypeDesc::STRING) {
+                metadata->emplace_back(key, attribute.get_string());
+            } else if (type == OIIO::TypeDesc::INT) {
+                metadata->emplace_back(key, attribute.get_int());
+            } else if (type == OIIO::TypeDesc::FLOAT) {
+                metadata->emplace_back(key, attribute.get_float());
+            }
         }
         // The EXR header keeps no order of its own: sort so results are reproducible.
-        std::sort(metadata->begin(), metadata->end());
+        std::sort(metadata->begin(), metadata->end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
     }
     return image;
 }

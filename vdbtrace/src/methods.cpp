@@ -56,19 +56,33 @@ nlohmann::json describeGeometry(const scenes::Scene&, const MethodSettings& s)
     return {{"samples_per_pixel", s.geometry.samples}};
 }
 
+int oneCone(const MethodSettings&) { return 1; }
+int referenceRays(const MethodSettings& s) { return s.reference.subpixels * s.reference.subpixels; }
+int geometrySamples(const MethodSettings& s) { return s.geometry.samples; }
+
 }  // namespace
 
 const std::vector<RenderMethod>& renderMethods()
 {
     static const std::vector<RenderMethod> methods = {
         {"multiscale", "closed forms, each hit at the level its footprint calls for",
-         multiscale, describeMultiscale},
+         multiscale, describeMultiscale, oneCone, true, true},
+        // The reference marches one set of grids merged from every tree.
         {"reference", "equation 7 numerically through OpenVDB grids of the boughs", reference,
-         describeReference},
+         describeReference, referenceRays, false, false},
         {"geometry", "explicit needle cylinders, point samples (the ground truth)", geometry,
-         describeGeometry},
+         describeGeometry, geometrySamples, false, true},
     };
     return methods;
+}
+
+bool computesAov(const RenderMethod& method, const std::string& aov, const EffectsPlan& plan)
+{
+    if (aov == "level") return method.levels;
+    if (aov == "tree") return method.treeIds;
+    if (aov == "diffuse") return plan.diffuse;
+    if (aov == "specular") return plan.specular;
+    return true;  // depth, foliage
 }
 
 const RenderMethod& renderMethod(const std::string& name)

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,7 @@ public:
         aovs.tree[i] = float(mTrees.dominant());
         // The pixel's coverage passes 1/2 at the ceil(S/2)-th nearest sample depth.
         const std::size_t half = std::size_t((mSamples + 1) / 2);
+        aovs.depth[i] = std::numeric_limits<float>::infinity();
         if (mDepths.size() >= half) {
             std::nth_element(mDepths.begin(), mDepths.begin() + std::ptrdiff_t(half - 1),
                              mDepths.end());
@@ -102,18 +104,33 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     const ConeCamera camera(scene.scene->camera);
+    const PixelWindow all{0, 0, camera.width(), camera.height()};
+    const PixelWindow w = options.window.empty() ? all : options.window;
+    if (w.x0 < 0 || w.y0 < 0 || w.x1 > all.x1 || w.y1 > all.y1) {
+        throw InputError("crop " + std::to_string(w.x0) + "," + std::to_string(w.y0) + "," +
+                         std::to_string(w.x1) + "," + std::to_string(w.y1) + " is outside the " +
+                         std::to_string(all.x1) + " x " + std::to_string(all.y1) + " frame");
+    }
     RenderResult result;
-    result.image = Image(camera.width(), camera.height());
+    result.image = Image(w.x1 - w.x0, w.y1 - w.y0);
     Image& image = result.image;
+    if (!options.window.empty()) {
+        image.originX = w.x0;
+        image.originY = w.y0;
+        image.frameWidth = all.x1;
+        image.frameHeight = all.y1;
+    }
     const Aovs aovs(image);
     const int samples = std::max(1, method.samplesPerPixel());
 
-    forEachTile(camera.width(), camera.height(), options.tileSize, options.progress, result.stats,
-                [&](int x0, int y0, int x1, int y1, RenderStats& stats) {
+    // Tiles of the window; each pixel traced at its place in the frame, so a crop holds the
+    // whole frame's pixels exactly.
+    forEachTile(image.width, image.height, options.tileSize, options.progress, result.stats,
+                [&](int tx0, int ty0, int tx1, int ty1, RenderStats& stats) {
         const std::unique_ptr<ShadingMethod::RayTracer> tracer = method.rayTracer(stats);
         PixelSum pixel;
-        for (int y = y0; y < y1; ++y) {
-            for (int x = x0; x < x1; ++x) {
+        for (int y = ty0 + w.y0; y < ty1 + w.y0; ++y) {
+            for (int x = tx0 + w.x0; x < tx1 + w.x0; ++x) {
                 const auto t0 = Clock::now();
                 pixel.clear();
                 for (int s = 0; s < samples; ++s) {
@@ -122,7 +139,7 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
                     tracer->trace(method.sample(camera, x, y, s), composite);
                     pixel.add(composite.value());
                 }
-                pixel.write(image, aovs, x, y);
+                pixel.write(image, aovs, x - w.x0, y - w.y0);
                 const int dominant = pixel.dominantLevel();
                 ++stats.pixelsPerLevel[dominant];
                 stats.nanosecondsPerLevel[dominant] += std::uint64_t(

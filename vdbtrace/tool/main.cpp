@@ -10,6 +10,7 @@
 #include "pine/support/progress.h"
 #include "pine/support/tool_main.h"
 #include "pine/vdbtrace/compare.h"
+#include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
@@ -23,6 +24,7 @@
 #include "pine/vdbtrace/traced_scene.h"
 
 #include <CLI/CLI.hpp>
+#include <glm/geometric.hpp>
 #include <tbb/task_arena.h>
 
 
@@ -32,6 +34,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -99,13 +102,16 @@ struct Loaded {
     vdbtrace::TracedScene traced;
 };
 
-/// The scene read, then `check`ed (what the work will need), then grown for the tracer.
+/// The scene read, `adjust`ed (the command line's overrides), then `check`ed (what the work
+/// will need), then grown for the tracer.
 std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model,
-                             const std::function<void(const scenes::Scene&)>& check = {})
+                             const std::function<void(const scenes::Scene&)>& check = {},
+                             const std::function<void(scenes::Scene&)>& adjust = {})
 {
     auto loaded = std::make_unique<Loaded>();
     loaded->scene = scenes::loadScene(file);
     model.apply(loaded->scene.render.model);
+    if (adjust) adjust(loaded->scene);
     if (check) check(loaded->scene);
     loaded->traced = vdbtrace::buildTracedScene(loaded->scene);
     return loaded;
@@ -148,6 +154,60 @@ void checkBakedFrom(const fs::path& file, const bake::BakeProvenance& from, cons
     }
 }
 
+/// "x0,y0,x1,y1", integers with 0 <= x0 < x1 and 0 <= y0 < y1.
+bool parseCrop(const std::string& text, vdbtrace::PixelWindow& window)
+{
+    int v[4];
+    char tail = 0;
+    if (std::sscanf(text.c_str(), "%d,%d,%d,%d%c", &v[0], &v[1], &v[2], &v[3], &tail) != 4) {
+        return false;
+    }
+    if (v[0] < 0 || v[1] < 0 || v[2] <= v[0] || v[3] <= v[1]) return false;
+    window = {v[0], v[1], v[2], v[3]};
+    return true;
+}
+
+vdbtrace::Matrix44 matrix44(const std::array<std::array<double, 4>, 4>& m)
+{
+    vdbtrace::Matrix44 out;
+    for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) out.m[i][j] = float(m[i][j]);
+    }
+    return out;
+}
+
+/// The render as its EXR holds it: RGBA, the AOVs the method computes, and depth as OpenEXR's
+/// Z, the distance along the view axis (the pixel centre's ray's), +infinity where nothing
+/// covers the pixel's middle.
+vdbtrace::Image forExr(const vdbtrace::Image& image, const vdbtrace::ConeCamera& camera,
+                       const std::function<bool(const std::string&)>& computed)
+{
+    vdbtrace::Image exr(image.width, image.height);
+    exr.originX = image.originX;
+    exr.originY = image.originY;
+    exr.frameWidth = image.frameWidth;
+    exr.frameHeight = image.frameHeight;
+    exr.rgba = image.rgba;
+    for (const auto& [name, values] : image.aovs) {
+        if (!computed(name)) continue;
+        if (name != "depth") {
+            exr.aovs[name] = values;
+            continue;
+        }
+        std::vector<float>& z = exr.aov("Z");
+        for (int y = 0; y < image.height; ++y) {
+            for (int x = 0; x < image.width; ++x) {
+                const std::size_t i = std::size_t(y) * std::size_t(image.width) + std::size_t(x);
+                const vdbtrace::ConeRay ray = camera.cone(x + image.originX, y + image.originY);
+                const double along = glm::dot(ray.direction, camera.forward());
+                z[i] = std::isfinite(values[i]) ? float(double(values[i]) * along)
+                                                : std::numeric_limits<float>::infinity();
+            }
+        }
+    }
+    return exr;
+}
+
 fs::path besideWith(const fs::path& image, const std::string& suffix)
 {
     fs::path p = image;
@@ -155,10 +215,16 @@ fs::path besideWith(const fs::path& image, const std::string& suffix)
     return p.string() + suffix;
 }
 
+/// What `render` changes of the scene's camera and frame from the command line.
+struct FrameOverrides {
+    int width = 0, height = 0;      ///< --resolution (0: the scene's)
+    vdbtrace::PixelWindow crop;     ///< --crop (empty: the whole frame)
+};
+
 int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs,
            vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles,
-           const ModelOverrides& model, double maxMemoryGiB)
+           const ModelOverrides& model, const FrameOverrides& frame, double maxMemoryGiB)
 {
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
     // The extension decides the format: only EXR holds the render (its PNG goes beside it).
@@ -176,6 +242,10 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         inputs.push_back(g.string() + ".json");
     }
     const bool levelPng = std::find(aovs.begin(), aovs.end(), "level") != aovs.end();
+    if (levelPng && !method.levels) {
+        throw InputError("--aov level: method '" + methodName +
+                         "' has no levels (multiscale shades at the paper's levels)");
+    }
     io::checkOutputsApart({out, besideWith(out, ".png"),
                            levelPng ? besideWith(out, ".level.png") : fs::path(), statsFile},
                           inputs);
@@ -196,52 +266,89 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         baked = bake::mergeTreeGrids(trees);  // checked against manifests or their metadata
         settings.grids = &*baked;
     }
-    const auto loaded = load(sceneFile, model, [&](const scenes::Scene& scene) {
-        const double voxelsRead = baked ? double(baked->layerOpacity->activeVoxelCount()) : 0.0;
-        bake::checkMemory(
-            bake::estimateRender(scene, methodName, settings.voxelSize_cm, voxelsRead),
-            bake::memoryLimit(maxMemoryGiB), sceneFile.string());
-    });
+    const auto loaded = load(
+        sceneFile, model,
+        [&](const scenes::Scene& scene) {
+            const vdbtrace::PixelWindow& c = frame.crop;
+            if (!c.empty() && (c.x1 > scene.camera.width || c.y1 > scene.camera.height)) {
+                throw InputError("--crop " + std::to_string(c.x0) + "," + std::to_string(c.y0) +
+                                 "," + std::to_string(c.x1) + "," + std::to_string(c.y1) +
+                                 " reaches outside the " + std::to_string(scene.camera.width) +
+                                 " x " + std::to_string(scene.camera.height) + " frame");
+            }
+            const double voxelsRead =
+                baked ? double(baked->layerOpacity->activeVoxelCount()) : 0.0;
+            bake::checkMemory(
+                bake::estimateRender(scene, methodName, settings.voxelSize_cm, voxelsRead),
+                bake::memoryLimit(maxMemoryGiB), sceneFile.string());
+        },
+        [&](scenes::Scene& scene) {
+            if (frame.width > 0) {
+                scene.camera.width = frame.width;
+                scene.camera.height = frame.height;
+            }
+        });
     for (std::size_t i = 0; i < bakedFrom.size(); ++i) {
         checkBakedFrom(gridFiles[i], bakedFrom[i], *loaded, sceneFile);
     }
     if (baked) {
-        std::cerr << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "
+        tool::info() << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "
                   << baked->voxelSize_cm << " cm read\n";
     }
-    std::cerr << "vdbtrace: " << sceneFile.string() << ": "
+    tool::info() << "vdbtrace: " << sceneFile.string() << ": "
               << describe(loaded->scene, loaded->traced) << '\n';
     settings.geometry.built = [](const vdbtrace::GeometryBuild& b) {
-        std::cerr << "vdbtrace: " << b.needles << " needles and " << b.branches
+        tool::info() << "vdbtrace: " << b.needles << " needles and " << b.branches
                   << " branches as cylinders, BVH built in " << b.seconds << " s ("
                   << double(b.primitiveBytes) / (1 << 20) << " MiB of cylinders, Embree peak "
                   << double(b.embreePeakBytes) / (1 << 20) << " MiB)\n";
     };
     if (methodName == "reference" && !baked) {
-        std::cerr << "vdbtrace: baking the boughs at " << settings.voxelSize_cm << " cm\n";
+        tool::info() << "vdbtrace: baking the boughs at " << settings.voxelSize_cm << " cm\n";
     }
     tool::Progress rendering("vdbtrace: rendering");
-    const vdbtrace::RenderResult result =
-        method.render(loaded->traced, settings, withProgress(rendering));
+    vdbtrace::RenderOptions options = withProgress(rendering);
+    options.window = frame.crop;
+    const vdbtrace::RenderResult result = method.render(loaded->traced, settings, options);
     rendering.finish();
 
     const auto& s = loaded->scene;
     const nlohmann::json effects = vdbtrace::toJson(vdbtrace::EffectsPlan::from(s.effects));
     const nlohmann::json methodSettings = method.describe(s, settings);
+    const vdbtrace::ConeCamera camera(s.camera);
+    // As pbrt-v4 and compositors read an EXR: render time, samples and camera matrices typed
+    // under their names; the rest under pine:, numbers as numbers.
     vdbtrace::Metadata metadata = {
+        {"renderTimeSeconds", float(result.seconds)},
+        {"samplesPerPixel", method.samplesPerPixel(settings)},
+        {"worldToCamera", matrix44(camera.worldToCamera())},
+        {"worldToNDC", matrix44(camera.worldToNdc())},
         {"pine:scene", sceneFile.string()},
         {"pine:method", methodName},
-        {"pine:render_seconds", std::to_string(result.seconds)},
-        {"pine:threads", std::to_string(tbb::this_task_arena::max_concurrency())},
+        {"pine:render_seconds", float(result.seconds)},
+        {"pine:prep_seconds", float(result.prepSeconds)},
+        {"pine:threads", tbb::this_task_arena::max_concurrency()},
         {"pine:effects", effects.dump()},
-        {"pine:level_thresholds", "needle<" + std::to_string(s.render.needleLevelMax) +
-                                      " cone<" + std::to_string(s.render.coneLevelMax) +
-                                      " (footprint / cone spacing)"},
-        {"pine:units", "cm"},
-        {"pine:prep_seconds", std::to_string(result.prepSeconds)}};
-    for (const auto& [key, value] : methodSettings.items()) {
-        metadata.emplace_back("pine:" + key, value.dump());
+        {"pine:units", "cm"}};
+    if (method.levels) {
+        metadata.emplace_back("pine:needle_level_max", float(s.render.needleLevelMax));
+        metadata.emplace_back("pine:cone_level_max", float(s.render.coneLevelMax));
     }
+    for (const auto& [key, value] : methodSettings.items()) {
+        if (value.is_number_integer()) {
+            metadata.emplace_back("pine:" + key, value.get<int>());
+        } else if (value.is_number()) {
+            metadata.emplace_back("pine:" + key, value.get<float>());
+        } else if (value.is_string()) {
+            metadata.emplace_back("pine:" + key, value.get<std::string>());
+        } else {
+            metadata.emplace_back("pine:" + key, value.dump());
+        }
+    }
+    const vdbtrace::Image exr =
+        forExr(result.image, camera, [&](const std::string& aov) {
+            return vdbtrace::computesAov(method, aov, vdbtrace::EffectsPlan::from(s.effects));
+        });
     // The previews and stats are put in place before the EXR, so that a failure among them
     // leaves the previous EXR and never a new one beside an old preview. Runs writing into
     // one folder take turns, so that these files come from one run.
@@ -266,15 +373,16 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         }
     };
     const io::FolderLock turn(io::FolderLock::of(out), [&] {
-        std::cerr << "vdbtrace: waiting for another run writing into '"
+        tool::info() << "vdbtrace: waiting for another run writing into '"
                   << io::FolderLock::of(out).string() << "'\n";
     });
     for (const fs::path& file : {out, besideWith(out, ".png"), besideWith(out, ".level.png")}) {
         io::removeStaleTemporaries(file);  // a killed run's: live ones wait for the lock
     }
-    vdbtrace::writeExr(result.image, out, metadata, writeBeside);
+    vdbtrace::writeExr(exr, out, metadata, writeBeside);
     const auto& st = result.stats;
-    std::cerr << "vdbtrace: " << out.string() << ": " << s.camera.width << "x" << s.camera.height
+    tool::info() << "vdbtrace: " << out.string() << ": " << result.image.width << "x"
+                 << result.image.height
               << " in " << result.seconds << " s, " << st.coneRays << " cone rays, "
               << st.shadowRays << " shadow rays; pixels by level needle/cone/bough "
               << st.pixelsPerLevel[1] << "/" << st.pixelsPerLevel[2] << "/" << st.pixelsPerLevel[3]
@@ -468,6 +576,24 @@ int main(int argc, char** argv)
     renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")
         ->required();
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
+    FrameOverrides frame;
+    std::string renderResolution, crop;
+    renderCmd->add_option("--resolution", renderResolution,
+                          "WxH instead of the camera's (same view, vertical field kept)")
+        ->check([](const std::string& text) {
+            int w = 0, h = 0;
+            return vdbtrace::parseResolution(text, w, h)
+                       ? std::string()
+                       : "expected WxH, each at most 16384, e.g. 640x480";
+        });
+    renderCmd->add_option("--crop", crop,
+                          "Only pixels [x0, x1) x [y0, y1) of the frame, as x0,y0,x1,y1 (row 0 "
+                          "at the top): the EXR's data window, each pixel as in the whole frame")
+        ->check([](const std::string& text) {
+            vdbtrace::PixelWindow w;
+            return parseCrop(text, w) ? std::string()
+                                      : "expected x0,y0,x1,y1 with 0 <= x0 < x1 and 0 <= y0 < y1";
+        });
     addMaxMemory(*renderCmd, maxMemoryGiB, "a render");
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
         ->check(CLI::IsMember({"level"}));
@@ -530,8 +656,12 @@ int main(int argc, char** argv)
                                      ", not " + method);
                 }
             }
+            if (!renderResolution.empty()) {
+                vdbtrace::parseResolution(renderResolution, frame.width, frame.height);
+            }
+            if (!crop.empty()) parseCrop(crop, frame.crop);
             return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles, model,
-                          maxMemoryGiB);
+                          frame, maxMemoryGiB);
         }
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
         if (*compareCmd) {
@@ -540,7 +670,7 @@ int main(int argc, char** argv)
             compare.machine = machineDescription();
             compare.model = [&model](scenes::ModelChoices& m) { model.apply(m); };
             compare.log = [](const std::string& line) {
-                std::cerr << "vdbtrace compare: " << line << '\n';
+                tool::info() << "vdbtrace compare: " << line << '\n';
             };
             if (!noPlot) compare.plot = plotCompare;
             if (!resolution.empty()) {

@@ -8,7 +8,8 @@
 
 namespace pine::tool {
 
-/// scripts/NAME in the source tree, or $PINE_PLOT_SCRIPT where set.
+/// $PINE_PLOT_SCRIPT where set, else NAME where `cmake --install` put it (share/pine beside the
+/// executable's bin/), else scripts/NAME in the source tree this was built from.
 std::filesystem::path plotScript(const std::string& name);
 
 /// Runs `/usr/bin/python3 SCRIPT FOLDER` with MPLBACKEND=Agg and waits for it: true if it

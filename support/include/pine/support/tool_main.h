@@ -5,16 +5,23 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <ostream>
 
 namespace pine::tool {
 
-/// Adds --threads to `app`, parses argv (--help prints and returns 0; a parse error prints one
+/// Adds --threads and --quiet to `app`, parses argv (--help prints and returns 0; a parse error prints one
 /// line "NAME: WHY (see --help)" and returns 2), limits TBB to the threads asked for, runs
 /// `body` and returns its status; what it throws becomes one line "NAME: WHAT" on stderr and
 /// status 2 for an InputError (the user's input or output) and for running out of memory
 /// (std::bad_alloc: what was asked of the machine), 1 for anything else.
 int run(const char* name, CLI::App& app, int argc, char** argv,
         const std::function<int()>& body);
+
+/// True under --quiet (which run adds to every tool).
+bool quiet();
+/// Where informational lines go: stderr, or nowhere under --quiet. Warnings and errors go to
+/// std::cerr whatever the flag.
+std::ostream& info();
 
 /// A finite number > 0 (CLI::PositiveNumber lets nan and inf through and prints DBL_MAX).
 CLI::Validator positiveNumber();

@@ -6,6 +6,8 @@
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/geometry.h"
 
+#include <array>
+
 namespace pine::vdbtrace {
 
 class ConeCamera {
@@ -18,6 +20,16 @@ public:
     ConeRay coneAt(double px, double py, double pixels) const;
     int width() const { return mWidth; }
     int height() const { return mHeight; }
+    /// The unit view axis.
+    const Vec3& forward() const { return mForward; }
+
+    /// The camera's matrices as pbrt-v4 writes them into an EXR header (m[row][column] of the
+    /// matrix taking column vectors; world in cm). Camera space: x right, y up, z along the
+    /// view axis (pbrt's, left-handed). NDC: after dividing by w, x and y are the image
+    /// position in [0, 1] over the whole image, x to the right and y down from the top-left
+    /// corner (as pixel rows run), and z is 1 / (camera-space z).
+    std::array<std::array<double, 4>, 4> worldToCamera() const;
+    std::array<std::array<double, 4>, 4> worldToNdc() const;
 
 private:
     Vec3 mEye, mForward, mRight, mUp;

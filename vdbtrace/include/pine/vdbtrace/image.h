@@ -9,16 +9,21 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <array>
 #include <utility>
+#include <variant>
 #include <vector>
 
 namespace pine::vdbtrace {
 
 /// Linear, premultiplied RGBA in scanline order (row 0 at the top), and AOVs of one float per
 /// pixel each (e.g. "level": coverage-weighted level in [1, 3], 0 where nothing was hit;
-/// "depth": distance in cm to the first hit, 0 where none).
+/// "depth": distance in cm to the first hit, +infinity where none).
 struct Image {
     int width = 0, height = 0;
+    /// A crop of a larger frame: where its top-left pixel lies in that frame, and the frame's
+    /// size (0: the image is the whole frame). EXR's data and display windows.
+    int originX = 0, originY = 0, frameWidth = 0, frameHeight = 0;
     std::vector<float> rgba;                         ///< 4 floats per pixel
     std::map<std::string, std::vector<float>> aovs;  ///< 1 float per pixel each
 
@@ -34,8 +39,18 @@ struct Image {
     }
 };
 
+/// A 4 x 4 matrix as pbrt-v4 stores camera matrices in an EXR header: m[row][column] of the
+/// matrix that takes column vectors (its translation in the last column).
+struct Matrix44 {
+    std::array<std::array<float, 4>, 4> m{};
+    bool operator==(const Matrix44&) const = default;
+};
+
+/// A header attribute's value: text, or typed (an EXR int, float or m44f attribute).
+using MetaValue = std::variant<std::string, int, float, Matrix44>;
+
 /// Key/value pairs stored in the file's header (render time, scene, method, settings, ...).
-using Metadata = std::vector<std::pair<std::string, std::string>>;
+using Metadata = std::vector<std::pair<std::string, MetaValue>>;
 
 /// What image reading and writing throw: about the user's input or output.
 class ImageError : public InputError {
@@ -43,11 +58,14 @@ public:
     using InputError::InputError;
 };
 
-/// OpenEXR, float: channels R, G, B, A and one channel per AOV named "<aov>.Y" (so that
-/// viewers show each AOV as a layer), metadata as string attributes. Written to a temporary
-/// name in the same folder, then renamed: never half-written. Throws ImageError, also for an
-/// empty or repeated metadata key and for keys that OpenEXR/OIIO interpret themselves
-/// ("compression", "name", "owner", "DateTime", "oiio:*", ...), which would not come back.
+/// OpenEXR, float: a crop's pixels as the data window inside its frame's display window;
+/// channels R, G, B, A and one channel per AOV named "<aov>.Y" (so that
+/// viewers show each AOV as a layer), except an AOV named "Z", OpenEXR's depth channel, written
+/// as is; metadata as attributes of their types. Written to a temporary name in the same
+/// folder, then renamed: never half-written. Throws ImageError, also for an empty or repeated
+/// metadata key and for keys that OpenEXR/OIIO interpret themselves ("compression", "name",
+/// "owner", "DateTime", "oiio:*", ...), which would not come back; "worldToCamera" and
+/// "worldToNDC" are taken as matrices only.
 /// beforeRename, if given, runs once the EXR is written and synced, before it is renamed into
 /// place: what it writes (the previews) is in place first, and if it throws the EXR is not.
 void writeExr(const Image& image, const std::filesystem::path& path, const Metadata& metadata,
@@ -62,8 +80,9 @@ void writePng(const Image& image, const std::filesystem::path& path);
 void writeLevelPng(const Image& image, const std::filesystem::path& path);
 
 /// Reads an EXR written by writeExr back (tests, and `vdbtrace diff` later). `metadata`
-/// receives the string attributes other than OpenEXR/OIIO's own, sorted by key (EXR headers
-/// keep no order). A missing A channel reads as 1. Throws ImageError naming the path.
+/// receives the string, int, float and matrix attributes other than OpenEXR/OIIO's own,
+/// sorted by key (EXR headers keep no order). A missing A channel reads as 1. Throws
+/// ImageError naming the path.
 Image readExr(const std::filesystem::path& path, Metadata* metadata = nullptr);
 
 }  // namespace pine::vdbtrace

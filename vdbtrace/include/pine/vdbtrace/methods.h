@@ -3,6 +3,7 @@
 #pragma once
 
 #include "pine/bake/tree_grids.h"
+#include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/reference_tracer.h"
@@ -33,7 +34,15 @@ struct RenderMethod {
                            const RenderOptions& options);
     /// The settings the method reads, as the stats JSON and the EXR header record them.
     nlohmann::json (*describe)(const scenes::Scene& scene, const MethodSettings& settings);
+    /// Rays (or cones) traced per pixel, as the EXR header's samplesPerPixel records them.
+    int (*samplesPerPixel)(const MethodSettings& settings);
+    bool levels;   ///< shades at the paper's levels (the "level" AOV means something)
+    bool treeIds;  ///< knows which tree each fragment comes from (the "tree" AOV)
 };
+
+/// Whether `method` computes AOV `aov` (of kAovNames) for a scene with these effects: what an
+/// output holds (the others are zero or unknown).
+bool computesAov(const RenderMethod& method, const std::string& aov, const EffectsPlan& plan);
 
 /// The registered methods: multiscale, reference, geometry.
 const std::vector<RenderMethod>& renderMethods();
