@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages this project builds and runs with; skips what is present.
-# Run as root (or with sudo available). Safe to run repeatedly.
+# Run as root (or with sudo available). Safe to run repeatedly. --test: also what only the tests
+# use (Blender).
 set -euo pipefail
 
 packages=(
@@ -13,6 +14,11 @@ packages=(
   libembree-dev
   python3-matplotlib python3-numpy python3-openvdb
 )
+
+# Only the tests need these: Blender renders baked proxies as a user would (tool.blender_interop).
+if [ "${1:-}" = "--test" ]; then
+  packages+=(blender)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
