@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 namespace pine::tool {
 
@@ -42,7 +43,11 @@ void Progress::show(double fraction, const std::string& text)
     if (mFinished || fraction <= mShown || quiet()) return;
     mShown = fraction;
     if (mTerminal) {
-        std::fprintf(stderr, "\r%s %s", mWhat.c_str(), text.c_str());
+        constexpr int kBar = 24;
+        const int filled = int(std::floor(kBar * fraction));
+        const std::string bar = std::string(std::size_t(filled), '#') +
+                                std::string(std::size_t(kBar - filled), '.');
+        std::fprintf(stderr, "\r%s [%s] %s", mWhat.c_str(), bar.c_str(), text.c_str());
         gLineOpen = true;
     } else {
         const int tenth = int(std::floor(10.0 * fraction));

@@ -78,6 +78,17 @@ for entry in instances["instances"]:
 print("pyopenvdb: %d trees read" % len(instances["instances"]))
 PY
 
+# vdb_lod names the levels it makes of density as our pyramid names its own.
+if command -v vdb_lod >/dev/null; then
+    vdb_lod "$work/m/tree_000.vdb" "$work/lod.vdb" -range 1-2 -name density >/dev/null 2>&1 || fail "vdb_lod failed"
+    theirs=$(vdb_print "$work/lod.vdb" | awk '{print $1}' | sort | paste -sd' ' -)
+    ours=$(vdb_print "$work/m/tree_000.vdb" | awk '{print $1}' | grep '^density_level_' | sort | paste -sd' ' -)
+    [ "$theirs" = "density_level_1 density_level_2" ] && [ "$ours" = "$theirs" ] \
+        || fail "vdb_lod's levels ($theirs) are not named as ours ($ours)"
+else
+    fail "vdb_lod is missing (libopenvdb-tools)"
+fi
+
 # A render reads the proxies back onto the scene's voxels: the image is the in-process bake's.
 trees=("$work/m/tree_000.vdb" "$work/m/tree_001.vdb" "$work/m/tree_002.vdb")
 "$vdbtrace" render "$work/scene.json" --method reference --voxel-size 2 --out "$work/inproc.exr" 2>"$work/err" \

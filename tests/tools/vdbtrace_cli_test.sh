@@ -25,6 +25,14 @@ expect_error "another method's option" 2 "voxel-size applies to --method referen
 grep "rendering" "$work/err" | awk '{ sub("%", "", $3); if ($3 + 0 < last) bad = 1; last = $3 + 0 } END { exit bad }' \
     || fail "progress out of order: $(grep rendering "$work/err" | tr '\n' ' ')"
 [ "$(grep -c rendering "$work/err")" -le 11 ] || fail "more than 11 progress lines in a file"
+# On a terminal (script(1) gives it one): a bar rewritten in place, ending its line.
+if command -v script >/dev/null; then
+    script -q -e -c "'$vdbtrace' render '$src/scenes/bough.json' --out '$work/tty.exr'" /dev/null >"$work/tty" 2>&1 \
+        || fail "render on a terminal failed: $(tail -c 300 "$work/tty")"
+    grep -q $'\rvdbtrace: rendering \[#*\.*\] *[0-9]*%' "$work/tty" || fail "no progress bar on a terminal: $(head -c 300 "$work/tty" | cat -v)"
+    grep -q 'rendering \[########################\] 100%' "$work/tty" || fail "the bar does not end full"
+    rm -f "$work/tty" "$work/tty.exr" "$work/tty.png"
+fi
 grep -q "1 tree, 3 branches, 271 needles" "$work/err" || fail "counts: $(head -1 "$work/err")"
 rm -f "$work/p.exr" "$work/p.png"
 # Outputs that would destroy an input, each other or a device, and formats the name does not

@@ -1,5 +1,5 @@
-// Long work's progress on stderr, as a person or a log expects it: one line rewritten in place
-// on a terminal; plain lines otherwise, one per tenth of the work, so that a log holds neither
+// Long work's progress on stderr, as a person or a log expects it: a bar rewritten in place on
+// a terminal; plain lines otherwise, one per tenth of the work, so that a log holds neither
 // fifty updates on one line nor thousands of lines.
 #pragma once
 
