@@ -75,6 +75,11 @@ for exr in "$base"/*.exr; do
   common=$(comm -12 <(channels "$exr" | sort) <(channels "$out/$stem.exr" | sort) | paste -sd, -)
   apart=$(comm -3 <(channels "$exr" | sort) <(channels "$out/$stem.exr" | sort) | tr -d '\t' | paste -sd' ' -)
   [ -z "$apart" ] || echo "regression: $stem: not in both, not compared: $apart" >&2
+  if [ -z "$common" ]; then
+    echo "regression: $stem: no channel in both" >&2
+    failed=$((failed + 1))
+    continue
+  fi
   oiiotool "$exr" --ch "$common" -o "$out/.base.exr" && oiiotool "$out/$stem.exr" --ch "$common" -o "$out/.new.exr"
   if ! idiff -q -fail 1e-6 -failpercent 0 -warn 1e-6 "$out/.base.exr" "$out/.new.exr" >/dev/null 2>&1; then
     echo "regression: $stem: pixels differ:" >&2

@@ -105,7 +105,7 @@ std::string readVerified(const fs::path& file, FileDigest* digest)
     const auto refuse = [&](const std::string& why) {
         return BakeError("'" + file.string() +
                          "' does not match its manifest (damaged, or changed since bake wrote "
-                         "it: without its manifest it is read unverified): " + why);
+                         "it): " + why);
     };
     const fs::path manifest = manifestPath(file);
     std::error_code error;

@@ -214,8 +214,9 @@ FileLayout checkFileMetadata(const openvdb::MetaMap* meta, const fs::path& path,
         throw refuse(e.what());
     }
     FileLayout layout;
+    const std::string unit = text(kUnitsKey);
     try {
-        layout.unit = lengthUnit(text(kUnitsKey));
+        layout.unit = lengthUnit(unit);
     } catch (const BakeError& e) {
         throw refuse(std::string(kUnitsKey) + ": " + e.what());
     }
@@ -267,8 +268,10 @@ void intoScene(openvdb::GridBase& grid, Field field, const FileLayout& layout, d
         for (int j = 0; j < 3; ++j) off = std::max(off, std::abs(inScene[i][j] - expected[i][j]));
     }
     if (!(off <= 1e-6 * h)) {
+        char size[32];
+        std::snprintf(size, sizeof size, "%g", h);
         throw BakeError("'" + path.string() + "': grid '" + grid.getName() +
-                        "' is not on the lattice of " + std::to_string(h) +
+                        "' is not on the lattice of " + size +
                         " cm voxels its metadata states (resampled or moved elsewhere?)");
     }
     grid.setTransform(lattice);
@@ -369,6 +372,15 @@ ReadGrids parseTreeGrids(const std::string& bytes, const fs::path& path, bool ve
         throw BakeError("cannot read '" + path.string() + "': " + e.what());
     }
     if (!grids) throw BakeError("cannot read '" + path.string() + "': no grids");
+    // A tool that keeps grids but not the file's metadata (a round trip through another
+    // program) leaves the copy bake puts on the density grid.
+    if (!meta || !meta->getMetadata<openvdb::Int32Metadata>(kFormatVersionKey)) {
+        const openvdb::GridBase::Ptr density = findGrid(*grids, kFields[0].name);
+        if (density && density->getMetadata<openvdb::Int32Metadata>(kFormatVersionKey)) {
+            meta = std::make_shared<openvdb::MetaMap>(
+                static_cast<const openvdb::MetaMap&>(*density));
+        }
+    }
 
     const FileLayout layout = checkFileMetadata(meta.get(), path, verified);
     const double h = meta->metaValue<double>(kVoxelSizeKey);

@@ -182,12 +182,12 @@ std::vector<fs::path> vdbFiles(const std::vector<fs::path>& paths)
 }
 
 /// Reads every file as a render would (manifest, then OpenVDB in a child process): one line
-/// each, status 2 if any is refused.
+/// each; status 2 if any is refused, else 3 if any was read without a manifest (unverified).
 int verify(const std::vector<fs::path>& paths, double maxMemoryGiB)
 {
     const std::vector<fs::path> files = vdbFiles(paths);
     if (files.empty()) throw InputError("no .vdb files in what was given");
-    int refused = 0;
+    int refused = 0, unverified = 0;
     for (const fs::path& file : files) {
         try {
             const bake::ReadGrids read =
@@ -196,16 +196,22 @@ int verify(const std::vector<fs::path>& paths, double maxMemoryGiB)
             std::cout << file.string() << ": " << (read.unverified.empty() ? "ok" : "unverified")
                       << ", " << grids.density->activeVoxelCount() << " voxels of "
                       << grids.voxelSize_cm << " cm, extinction law " << grids.extinctionLaw;
-            if (!read.unverified.empty()) std::cout << " (" << read.unverified << ")";
+            if (!read.unverified.empty()) {
+                std::cout << " (" << read.unverified << ")";
+                ++unverified;
+            }
             std::cout << "\n";
         } catch (const InputError& e) {
             std::cout << file.string() << ": refused: " << e.what() << "\n";
             ++refused;
         }
     }
-    std::cerr << "bake: " << files.size() - std::size_t(refused) << " of " << files.size()
-              << " files read whole\n";
-    return refused == 0 ? 0 : 2;
+    tool::info() << "bake: " << files.size() - std::size_t(refused) << " of " << files.size()
+                 << " files read whole";
+    if (unverified > 0) tool::info() << ", " << unverified << " of them unverified";
+    tool::info() << '\n';
+    // A render reads an unverified file; a check says it could not vouch for it.
+    return refused > 0 ? 2 : unverified > 0 ? 3 : 0;
 }
 
 }  // namespace
@@ -264,7 +270,8 @@ int main(int argc, char** argv)
 
     std::vector<fs::path> verifyPaths;
     auto* verifyCmd = app.add_subcommand(
-        "verify", "Check baked files as a render reads them (manifest, then OpenVDB isolated)");
+        "verify", "Check baked files as a render reads them (manifest, then OpenVDB isolated); "
+                  "exit status 2 if any is refused, 3 if any has no manifest");
     verifyCmd->add_option("paths", verifyPaths, ".vdb files, or folders of them")->required();
     verifyCmd->add_option("--max-memory", maxMemoryGiB,
                           "Memory OpenVDB may use to read one file, in GiB (default: 80% of "

@@ -194,6 +194,7 @@ TEST(TreeGridsIo, InATreesFrameTheTreeStandsAtTheOriginInMetres)
         const auto mg = memGradient.getValue(ijk), fg = fileGradient.getValue(ijk);
         const Vec3 perMetre = intoTree(Vec3(mg.x(), mg.y(), mg.z()) + base) * 100.0;
         ASSERT_NEAR(fg.x(), perMetre.x, 1e-5 * glm::length(perMetre));
+        ASSERT_NEAR(fg.y(), perMetre.y, 1e-5 * glm::length(perMetre));
         ASSERT_NEAR(fg.z(), perMetre.z, 1e-5 * glm::length(perMetre));
     }
     EXPECT_EQ(checked, int(g.density->activeVoxelCount()));
@@ -485,7 +486,12 @@ TEST(TreeGridsIo, AnotherFormatVersionOrAnUnknownLawIsRefused)
     };
     openvdb::MetaMap old = *meta;
     old.removeMeta("pine:format_version");
-    rewrite(old);
+    openvdb::GridPtrVec oldGrids = *grids;  // nor on the density grid (its copy is read too)
+    for (auto& grid : oldGrids) {
+        grid = grid->copyGrid();
+        grid->removeMeta("pine:format_version");
+    }
+    rewrite(old, &oldGrids);
     expectRefused(file, "no pine:format_version");
     openvdb::MetaMap future = *meta;
     future.insertMeta("pine:format_version", openvdb::Int32Metadata(kFormatVersion + 1));
@@ -519,7 +525,17 @@ TEST(TreeGridsIo, AnotherFormatVersionOrAnUnknownLawIsRefused)
         grid->setTransform(xform);
     }
     rewrite(*meta, &moved);
-    expectRefused(file, "grid 'layer_opacity' is not on the lattice");
+    expectRefused(file, "grid 'layer_opacity' is not on the lattice of 0.8 cm voxels");
+    // Within a millionth of a voxel (what float transforms from another tool keep) it is read.
+    openvdb::GridPtrVec nudged = *grids;
+    for (auto& grid : nudged) {
+        grid = grid->copyGrid();
+        auto xform = grid->transform().copy();
+        xform->postTranslate(openvdb::Vec3d(1e-9, 0.0, 0.0));  // metres: 1e-7 cm
+        grid->setTransform(xform);
+    }
+    rewrite(*meta, &nudged);
+    EXPECT_NO_THROW(readTreeGrids(file));
     rewrite(*meta);
     EXPECT_EQ(readTreeGrids(file).grids.extinctionLaw, BakeSettings{}.extinctionLaw);
 }
@@ -536,6 +552,22 @@ TEST(TreeGridsIo, AGridWithoutAManifestIsReadUnverifiedFromItsMetadata)
         << read.unverified;
     expectSameGrids(verified.grids, read.grids, 0.0);
     EXPECT_EQ(read.provenance.treeDigest, kProvenance.treeDigest);
+
+    // Through a tool that keeps the grids but drops the file's metadata: the density grid's
+    // copy of it is read.
+    {
+        openvdb::io::File in(file.string());
+        in.open();
+        const openvdb::GridPtrVecPtr grids = in.getGrids();
+        in.close();
+        const fs::path resaved = dir.path() / "resaved.vdb";
+        openvdb::io::File out(resaved.string());
+        out.write(*grids);  // no file metadata
+        out.close();
+        const ReadGrids again = readTreeGrids(resaved);
+        EXPECT_FALSE(again.unverified.empty());
+        expectSameGrids(verified.grids, again.grids, 0.0);
+    }
 
     // A grid another tool made with nothing said of it: refused in one line.
     const fs::path foreign = dir.path() / "foreign.vdb";

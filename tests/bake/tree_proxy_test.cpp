@@ -105,6 +105,25 @@ TEST(TreeProxy, TheBranchMeshIsAClosedOutwardSolidOfTheCylinders)
     }
 }
 
+TEST(TreeProxy, AFileFrameIsTheTreesBaseAndTurnInTheUnit)
+{
+    // toFile, written out apart: R(-turn) (p - base) / unit.
+    const Vec3 base(110.0, -40.0, 5.0);
+    for (const double turn : {0.0, 0.9, -2.4}) {
+        const FileLayout layout{LengthUnit::Metre, TreeFrame{base, turn}};
+        for (const Vec3 p : {Vec3(110.0, -40.0, 5.0), Vec3(160.0, -10.0, 120.0), Vec3(-3, 7, 1)}) {
+            const Vec3 q = p - base;
+            const Vec3 expected = Vec3(std::cos(turn) * q.x + std::sin(turn) * q.y,
+                                       -std::sin(turn) * q.x + std::cos(turn) * q.y, q.z) /
+                                  100.0;
+            const Vec3 got = toFile(p, layout);
+            for (int i = 0; i < 3; ++i) EXPECT_NEAR(got[i], expected[i], 1e-12);
+        }
+    }
+    EXPECT_EQ(toFile(Vec3(1.0, 2.0, 3.0), FileLayout{LengthUnit::Centimetre, std::nullopt}),
+              Vec3(1.0, 2.0, 3.0));
+}
+
 TEST(TreeProxy, TheInstanceListPutsEachTreeBackWhereTheSceneHasIt)
 {
     const TreeFrame frame{Vec3(110.0, -40.0, 5.0), 2.2};

@@ -168,15 +168,27 @@ def run(argv):
 
 
 def finite_pixels(exr):
+    """No NaN in any channel, no infinity but in Z (OpenEXR's depth: +inf where nothing is
+    hit)."""
+    info = subprocess.run(["oiiotool", "--info", "-v", exr], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True)
     r = subprocess.run(["oiiotool", exr, "--printstats"], stdout=subprocess.PIPE,
                        stderr=subprocess.PIPE, text=True)
-    if r.returncode != 0:
-        return False, "unreadable: " + r.stderr.strip()[:200]
+    if r.returncode != 0 or info.returncode != 0:
+        return False, "unreadable: " + (r.stderr + info.stderr).strip()[:200]
+    channels = []
+    for line in info.stdout.splitlines():
+        if line.strip().startswith("channel list:"):
+            channels = [c.strip() for c in line.split(":", 1)[1].split(",")]
     for line in r.stdout.splitlines():
         line = line.strip()
         if line.startswith("Stats NanCount:") or line.startswith("Stats InfCount:"):
-            if any(int(n) for n in line.split(":")[1].split()):
-                return False, line
+            counts = [int(n) for n in line.split(":")[1].split()]
+            if len(counts) != len(channels):
+                return False, f"{line} for channels {channels}"
+            for channel, n in zip(channels, counts):
+                if n and not (channel == "Z" and line.startswith("Stats InfCount:")):
+                    return False, f"{line} ({channel})"
     return True, ""
 
 

@@ -55,7 +55,9 @@ grep -q "b.vdb: refused: .*bytes, the manifest says" "$work/out" || fail "verify
 grep -q "1 of 2 files read whole" "$work/err" || fail "verify: $(cat "$work/err")"
 # Without its manifest a bake is read from its metadata, and said to be unverified.
 rm "$work/v/b.vdb" "$work/v/b.vdb.json" "$work/v/a.vdb.json"
-"$tool" verify "$work/v/a.vdb" >"$work/out" 2>"$work/err" || fail "verify without a manifest: $(cat "$work/out")"
+"$tool" verify "$work/v/a.vdb" >"$work/out" 2>"$work/err"
+[ $? -eq 3 ] || fail "verify without a manifest: exit status is not 3: $(cat "$work/out")"
+grep -q "1 of 1 files read whole, 1 of them unverified" "$work/err" || fail "verify: $(cat "$work/err")"
 grep -q "a.vdb: unverified, .*no manifest 'a.vdb.json'" "$work/out" || fail "verify: $(cat "$work/out")"
 rm -r "$work/v"
 

@@ -113,6 +113,12 @@ expect_error "a tree the scene lacks" 2 "was baked from tree 2 of .*which '.*mov
     render "$work/moved.json" --method reference --grids "$work/m/tree_002.vdb" --out "$work/x.exr"
 [ -e "$work/x.exr" ] && fail "a refused render wrote its image"
 
+expect_error "one tree twice" 2 "are both tree 1 of" -- render "$work/scene.json" --method reference \
+    --grids "$work/m/tree_001.vdb" "$work/cm/tree_001.vdb" --out "$work/x.exr"
+"$vdbtrace" render "$work/scene.json" --method reference --grids "$work/m/tree_001.vdb" --out "$work/some.exr" 2>"$work/err" \
+    || fail "render of one tree's proxy: $(tail -1 "$work/err")"
+grep -q "warning: --grids holds 1 of the 3 trees" "$work/err" || fail "no warning for missing trees: $(cat "$work/err")"
+
 # Without its manifest (copied or edited elsewhere) a proxy is read, with a warning.
 rm "$work/m/tree_001.vdb.json"
 "$vdbtrace" render "$work/scene.json" --method reference --grids "${trees[@]}" --out "$work/unverified.exr" 2>"$work/err" \

@@ -97,6 +97,18 @@ grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, level.Y, specular.Y,
 grep -q "samplesPerPixel: 1$" "$work/info" || fail "multiscale EXR lacks samplesPerPixel 1"
 grep -q "renderTimeSeconds: [0-9.e-]*$" "$work/info" || fail "EXR lacks a float renderTimeSeconds"
 grep -q "worldToCamera: " "$work/info" && grep -q "worldToNDC: " "$work/info" || fail "EXR lacks camera matrices"
+# OpenEXR's convention (row vectors): the camera's position maps to the origin, p M = 0, and
+# the translation lies in the last row (a column-vector matrix would have it in the last column).
+/usr/bin/python3 - "$work/info" "$src/scenes/bough.json" <<'PY' || fail "worldToCamera is not OpenEXR's row-vector matrix"
+import json, re, sys
+text = open(sys.argv[1]).read()
+m = [float(v) for v in re.search(r"worldToCamera: ([^\n]*)", text).group(1).split(",")]
+M = [m[0:4], m[4:8], m[8:12], m[12:16]]
+eye = json.load(open(sys.argv[2]))["camera"]["position"] + [1.0]
+image = [sum(eye[i] * M[i][j] for i in range(4)) for j in range(4)]
+assert all(abs(v) < 1e-3 for v in image[:3]) and abs(image[3] - 1) < 1e-6, image
+assert all(abs(M[i][3]) < 1e-9 for i in range(3)) and M[3][3] == 1.0, M
+PY
 grep -q 'pine:needle_level_max: 0.25$' "$work/info" || fail "level thresholds not typed: $(grep level_max "$work/info")"
 oiiotool "$work/b.exr" --ch A --printstats 2>&1 | grep -q "Stats Min: 0.0* (float)" || fail "bough.json should leave background"
 # Where alpha is 0 nothing is hit: Z is +inf there (oiiotool counts it as an Inf pixel).

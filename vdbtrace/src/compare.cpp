@@ -64,7 +64,10 @@ CompareRun runCompare(const CompareOptions& options)
     io::writeTextAtomically(dir / "report.csv", reportCsv(run.rows));
     if (options.plot) {
         info.plotted = options.plot(dir);
-        if (!info.plotted) log("warning: plotting failed (report.csv has the data)");
+        if (!info.plotted) {
+            (options.warn ? options.warn : log)(
+                "warning: plotting failed (report.csv has the data)");
+        }
     }
     DollyFlicker flicker;
     if (options.flicker) {

@@ -35,6 +35,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <map>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -167,11 +168,13 @@ bool parseCrop(const std::string& text, vdbtrace::PixelWindow& window)
     return true;
 }
 
+/// A matrix for column vectors as OpenEXR's attribute holds it: transposed, for row vectors
+/// (the array pbrt-v4 writes is the untransposed one, which OpenEXR readers take transposed).
 vdbtrace::Matrix44 matrix44(const std::array<std::array<double, 4>, 4>& m)
 {
     vdbtrace::Matrix44 out;
     for (int i = 0; i < 4; ++i) {
-        for (int j = 0; j < 4; ++j) out.m[i][j] = float(m[i][j]);
+        for (int j = 0; j < 4; ++j) out.m[i][j] = float(m[j][i]);
     }
     return out;
 }
@@ -288,8 +291,22 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                 scene.camera.height = frame.height;
             }
         });
+    std::map<int, fs::path> treesRead;  // a tree given twice would be drawn twice
     for (std::size_t i = 0; i < bakedFrom.size(); ++i) {
         checkBakedFrom(gridFiles[i], bakedFrom[i], *loaded, sceneFile);
+        if (bakedFrom[i].treeDigest.empty()) continue;
+        const auto [at, fresh] = treesRead.emplace(bakedFrom[i].tree, gridFiles[i]);
+        if (!fresh) {
+            throw InputError("--grids: '" + at->second.string() + "' and '" +
+                             gridFiles[i].string() + "' are both tree " +
+                             std::to_string(bakedFrom[i].tree) + " of '" + sceneFile.string() +
+                             "'");
+        }
+    }
+    if (!treesRead.empty() && treesRead.size() < loaded->traced.trees.size()) {
+        std::cerr << "vdbtrace: warning: --grids holds " << treesRead.size() << " of the "
+                  << loaded->traced.trees.size() << " trees of '" << sceneFile.string()
+                  << "': the others render without foliage\n";
     }
     if (baked) {
         tool::info() << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "
@@ -316,8 +333,8 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     const nlohmann::json effects = vdbtrace::toJson(vdbtrace::EffectsPlan::from(s.effects));
     const nlohmann::json methodSettings = method.describe(s, settings);
     const vdbtrace::ConeCamera camera(s.camera);
-    // As pbrt-v4 and compositors read an EXR: render time, samples and camera matrices typed
-    // under their names; the rest under pine:, numbers as numbers.
+    // As compositors and pbrt-v4 read an EXR: render time, samples (pbrt-v4's names) and
+    // OpenEXR's camera matrices, typed; the rest under pine:, numbers as numbers.
     vdbtrace::Metadata metadata = {
         {"renderTimeSeconds", float(result.seconds)},
         {"samplesPerPixel", method.samplesPerPixel(settings)},
@@ -671,6 +688,9 @@ int main(int argc, char** argv)
             compare.model = [&model](scenes::ModelChoices& m) { model.apply(m); };
             compare.log = [](const std::string& line) {
                 tool::info() << "vdbtrace compare: " << line << '\n';
+            };
+            compare.warn = [](const std::string& line) {
+                std::cerr << "vdbtrace compare: " << line << '\n';
             };
             if (!noPlot) compare.plot = plotCompare;
             if (!resolution.empty()) {

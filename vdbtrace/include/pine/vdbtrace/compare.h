@@ -21,6 +21,7 @@ struct CompareOptions {
     bool flicker = true;        ///< render the dolly (flicker.csv)
     std::string machine = "unknown machine";  ///< for the report: CPU, cores, threads
     CompareLog log;             ///< progress lines for a person; the last one sums up
+    CompareLog warn;            ///< what went wrong but did not stop the run (null: to log)
     /// Draws error_vs_time.png from report.csv in the folder; true if it did. Null: no plot.
     std::function<bool(const std::filesystem::path& dir)> plot;
 };

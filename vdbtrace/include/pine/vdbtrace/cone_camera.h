@@ -23,11 +23,12 @@ public:
     /// The unit view axis.
     const Vec3& forward() const { return mForward; }
 
-    /// The camera's matrices as pbrt-v4 writes them into an EXR header (m[row][column] of the
-    /// matrix taking column vectors; world in cm). Camera space: x right, y up, z along the
-    /// view axis (pbrt's, left-handed). NDC: after dividing by w, x and y are the image
-    /// position in [0, 1] over the whole image, x to the right and y down from the top-left
-    /// corner (as pixel rows run), and z is 1 / (camera-space z).
+    /// The camera's matrices, m[row][column] for column vectors (world in cm); an EXR header
+    /// holds them transposed (OpenEXR's worldToCamera and worldToNDC). Camera space: x right,
+    /// y up, z along the view axis (left-handed, as RenderMan's and pbrt's). NDC (RenderMan's):
+    /// after dividing by w, x and y are the image position in [0, 1] over the whole frame, x
+    /// to the right and y down from the top-left corner (as pixel rows run); z is
+    /// 1 / (camera-space z).
     std::array<std::array<double, 4>, 4> worldToCamera() const;
     std::array<std::array<double, 4>, 4> worldToNdc() const;
 

@@ -39,8 +39,8 @@ struct Image {
     }
 };
 
-/// A 4 x 4 matrix as pbrt-v4 stores camera matrices in an EXR header: m[row][column] of the
-/// matrix that takes column vectors (its translation in the last column).
+/// A 4 x 4 matrix as OpenEXR's m44f attributes hold it (Imath): for row vectors, p' = p m,
+/// its translation in the last row.
 struct Matrix44 {
     std::array<std::array<float, 4>, 4> m{};
     bool operator==(const Matrix44&) const = default;
