@@ -310,15 +310,15 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     }
     if (baked) {
         tool::info() << "vdbtrace: " << baked->layerOpacity->activeVoxelCount() << " voxels of "
-                  << baked->voxelSize_cm << " cm read\n";
+                     << baked->voxelSize_cm << " cm read\n";
     }
     tool::info() << "vdbtrace: " << sceneFile.string() << ": "
-              << describe(loaded->scene, loaded->traced) << '\n';
+                 << describe(loaded->scene, loaded->traced) << '\n';
     settings.geometry.built = [](const vdbtrace::GeometryBuild& b) {
         tool::info() << "vdbtrace: " << b.needles << " needles and " << b.branches
-                  << " branches as cylinders, BVH built in " << b.seconds << " s ("
-                  << double(b.primitiveBytes) / (1 << 20) << " MiB of cylinders, Embree peak "
-                  << double(b.embreePeakBytes) / (1 << 20) << " MiB)\n";
+                     << " branches as cylinders, BVH built in " << b.seconds << " s ("
+                     << double(b.primitiveBytes) / (1 << 20) << " MiB of cylinders, Embree peak "
+                     << double(b.embreePeakBytes) / (1 << 20) << " MiB)\n";
     };
     if (methodName == "reference" && !baked) {
         tool::info() << "vdbtrace: baking the boughs at " << settings.voxelSize_cm << " cm\n";
@@ -384,6 +384,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             j["method"] = methodName;
             j["effects"] = effects;
             j["resolution"] = {s.camera.width, s.camera.height};
+            if (!frame.crop.empty()) {
+                j["crop"] = {frame.crop.x0, frame.crop.y0, frame.crop.x1, frame.crop.y1};
+            }
             j["threads"] = tbb::this_task_arena::max_concurrency();
             j.update(methodSettings);
             vdbtrace::writeJsonAtomically(j, statsFile);
@@ -391,7 +394,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     };
     const io::FolderLock turn(io::FolderLock::of(out), [&] {
         tool::info() << "vdbtrace: waiting for another run writing into '"
-                  << io::FolderLock::of(out).string() << "'\n";
+                     << io::FolderLock::of(out).string() << "'\n";
     });
     for (const fs::path& file : {out, besideWith(out, ".png"), besideWith(out, ".level.png")}) {
         io::removeStaleTemporaries(file);  // a killed run's: live ones wait for the lock
@@ -399,11 +402,10 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     vdbtrace::writeExr(exr, out, metadata, writeBeside);
     const auto& st = result.stats;
     tool::info() << "vdbtrace: " << out.string() << ": " << result.image.width << "x"
-                 << result.image.height
-              << " in " << result.seconds << " s, " << st.coneRays << " cone rays, "
-              << st.shadowRays << " shadow rays; pixels by level needle/cone/bough "
-              << st.pixelsPerLevel[1] << "/" << st.pixelsPerLevel[2] << "/" << st.pixelsPerLevel[3]
-              << '\n';
+                 << result.image.height << " in " << result.seconds << " s, " << st.coneRays
+                 << " cone rays, " << st.shadowRays << " shadow rays; pixels by level "
+                 << "needle/cone/bough " << st.pixelsPerLevel[1] << "/" << st.pixelsPerLevel[2]
+                 << "/" << st.pixelsPerLevel[3] << '\n';
     return 0;
 }
 
