@@ -60,7 +60,7 @@ CompareRun runCompare(const CompareOptions& options)
     info.settings = st;
     info.machine = options.machine;
     info.errorScale = commonErrorScale(run.rows);
-    writeRowImages(run, options.sceneFile, scene.render.background, info.errorScale, dir);
+    writeRowImages(run, options.sceneFile, scene, info.errorScale, dir);
     io::writeTextAtomically(dir / "report.csv", reportCsv(run.rows));
     if (options.plot) {
         info.plotted = options.plot(dir);

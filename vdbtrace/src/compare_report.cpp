@@ -1,5 +1,6 @@
 #include "pine/vdbtrace/compare_report.h"
 
+#include "pine/vdbtrace/exr_output.h"
 #include "pine/vdbtrace/preview.h"
 
 #include <algorithm>
@@ -141,16 +142,21 @@ double commonErrorScale(const std::vector<CompareRow>& rows)
 }
 
 void writeRowImages(const CompareRun& run, const std::filesystem::path& sceneFile,
-                    const scenes::Vec3& background, double errorScale,
+                    const scenes::Scene& scene, double errorScale,
                     const std::filesystem::path& dir)
 {
+    const ConeCamera camera(scene.camera);
     for (const CompareRow& r : run.rows) {
-        const Metadata m = {{"pine:scene", sceneFile.string()},
-                            {"pine:method", r.method},
-                            {"pine:setting", r.setting},
-                            {"pine:render_seconds", std::to_string(r.seconds)}};
-        writeExr(r.image, dir / (r.stem() + ".exr"), m);
-        writePreviewPng(r.image, background, dir / (r.stem() + ".png"));
+        Metadata m = cameraMetadata(camera);
+        m.insert(m.end(), {{"renderTimeSeconds", float(r.seconds)},
+                           {"pine:scene", sceneFile.string()},
+                           {"pine:method", r.method},
+                           {"pine:setting", r.setting},
+                           {"pine:render_seconds", float(r.seconds)}});
+        writeExr(exrImage(r.image, camera, renderMethod(r.renderer),
+                          EffectsPlan::from(scene.effects)),
+                 dir / (r.stem() + ".exr"), m);
+        writePreviewPng(r.image, scene.render.background, dir / (r.stem() + ".png"));
         if (!r.truth) writeErrorPng(r.errors, errorScale, dir / (r.stem() + ".error.png"));
     }
 }

@@ -14,6 +14,7 @@ CompareRow render(const TracedScene& traced, const std::string& method, std::str
     RenderResult r = renderMethod(method).render(traced, settings, {});
     CompareRow row;
     row.method = std::move(label);
+    row.renderer = method;
     row.setting = std::move(setting);
     row.seconds = r.seconds;
     if (method != "multiscale") row.prepSeconds = r.prepSeconds;

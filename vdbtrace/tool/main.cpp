@@ -11,6 +11,7 @@
 #include "pine/support/tool_main.h"
 #include "pine/vdbtrace/compare.h"
 #include "pine/vdbtrace/cone_camera.h"
+#include "pine/vdbtrace/exr_output.h"
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
@@ -168,49 +169,6 @@ bool parseCrop(const std::string& text, vdbtrace::PixelWindow& window)
     return true;
 }
 
-/// A matrix for column vectors as OpenEXR's attribute holds it: transposed, for row vectors
-/// (the array pbrt-v4 writes is the untransposed one, which OpenEXR readers take transposed).
-vdbtrace::Matrix44 matrix44(const std::array<std::array<double, 4>, 4>& m)
-{
-    vdbtrace::Matrix44 out;
-    for (int i = 0; i < 4; ++i) {
-        for (int j = 0; j < 4; ++j) out.m[i][j] = float(m[j][i]);
-    }
-    return out;
-}
-
-/// The render as its EXR holds it: RGBA, the AOVs the method computes, and depth as OpenEXR's
-/// Z, the distance along the view axis (the pixel centre's ray's), +infinity where nothing
-/// covers the pixel's middle.
-vdbtrace::Image forExr(const vdbtrace::Image& image, const vdbtrace::ConeCamera& camera,
-                       const std::function<bool(const std::string&)>& computed)
-{
-    vdbtrace::Image exr(image.width, image.height);
-    exr.originX = image.originX;
-    exr.originY = image.originY;
-    exr.frameWidth = image.frameWidth;
-    exr.frameHeight = image.frameHeight;
-    exr.rgba = image.rgba;
-    for (const auto& [name, values] : image.aovs) {
-        if (!computed(name)) continue;
-        if (name != "depth") {
-            exr.aovs[name] = values;
-            continue;
-        }
-        std::vector<float>& z = exr.aov("Z");
-        for (int y = 0; y < image.height; ++y) {
-            for (int x = 0; x < image.width; ++x) {
-                const std::size_t i = std::size_t(y) * std::size_t(image.width) + std::size_t(x);
-                const vdbtrace::ConeRay ray = camera.cone(x + image.originX, y + image.originY);
-                const double along = glm::dot(ray.direction, camera.forward());
-                z[i] = std::isfinite(values[i]) ? float(double(values[i]) * along)
-                                                : std::numeric_limits<float>::infinity();
-            }
-        }
-    }
-    return exr;
-}
-
 fs::path besideWith(const fs::path& image, const std::string& suffix)
 {
     fs::path p = image;
@@ -335,18 +293,17 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     const vdbtrace::ConeCamera camera(s.camera);
     // As compositors and pbrt-v4 read an EXR: render time, samples (pbrt-v4's names) and
     // OpenEXR's camera matrices, typed; the rest under pine:, numbers as numbers.
-    vdbtrace::Metadata metadata = {
+    vdbtrace::Metadata metadata = vdbtrace::cameraMetadata(camera);
+    metadata.insert(metadata.end(), {
         {"renderTimeSeconds", float(result.seconds)},
         {"samplesPerPixel", method.samplesPerPixel(settings)},
-        {"worldToCamera", matrix44(camera.worldToCamera())},
-        {"worldToNDC", matrix44(camera.worldToNdc())},
         {"pine:scene", sceneFile.string()},
         {"pine:method", methodName},
         {"pine:render_seconds", float(result.seconds)},
         {"pine:prep_seconds", float(result.prepSeconds)},
         {"pine:threads", tbb::this_task_arena::max_concurrency()},
         {"pine:effects", effects.dump()},
-        {"pine:units", "cm"}};
+        {"pine:units", "cm"}});
     if (method.levels) {
         metadata.emplace_back("pine:needle_level_max", float(s.render.needleLevelMax));
         metadata.emplace_back("pine:cone_level_max", float(s.render.coneLevelMax));
@@ -363,9 +320,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         }
     }
     const vdbtrace::Image exr =
-        forExr(result.image, camera, [&](const std::string& aov) {
-            return vdbtrace::computesAov(method, aov, vdbtrace::EffectsPlan::from(s.effects));
-        });
+        vdbtrace::exrImage(result.image, camera, method, vdbtrace::EffectsPlan::from(s.effects));
     // The previews and stats are put in place before the EXR, so that a failure among them
     // leaves the previous EXR and never a new one beside an old preview. Runs writing into
     // one folder take turns, so that these files come from one run.

@@ -30,10 +30,11 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
 /// but the truth, so one outlier does not darken every map and equal colours mean equal error.
 double commonErrorScale(const std::vector<CompareRow>& rows);
 
-/// Each row's EXR (with its method and setting in the header), PNG preview over `background`
-/// and, but for the truth, its error map at `errorScale`, into `dir`.
+/// Each row's EXR (as `render` writes it, exr_output.h, with its method and setting in the
+/// header), PNG preview over the scene's background and, but for the truth, its error map at
+/// `errorScale`, into `dir`.
 void writeRowImages(const CompareRun& run, const std::filesystem::path& sceneFile,
-                    const scenes::Vec3& background, double errorScale,
+                    const scenes::Scene& scene, double errorScale,
                     const std::filesystem::path& dir);
 
 }  // namespace pine::vdbtrace

@@ -30,7 +30,8 @@ struct CompareSettings {
 
 /// One render of the sweep and its error against the ground truth.
 struct CompareRow {
-    std::string method, setting;
+    std::string method, setting;  ///< as the report names them ("truth" among the methods)
+    std::string renderer;         ///< the registered method that rendered it (methods.h)
     double seconds = 0.0;
     std::optional<double> prepSeconds;  ///< what the method prepared first (in `seconds`)
     Image image;
