@@ -47,7 +47,7 @@ openvdb::Mat4d worldToFile(const FileLayout& layout)
     const TreeFrame frame = layout.treeFrame.value_or(TreeFrame{});
     // p' = R(-theta) (p - base) / u, R a turn about z.
     const double c = std::cos(frame.rotation_rad), s = std::sin(frame.rotation_rad);
-    const double r[3][3] = {{c, s, 0.0}, {-s, c, 0.0}, {0.0, 0.0, 1.0}};  // R(-theta), columns
+    const double r[3][3] = {{c, s, 0.0}, {-s, c, 0.0}, {0.0, 0.0, 1.0}};  // R(-theta), [row][col]
     openvdb::Mat4d m = openvdb::Mat4d::identity();
     for (int i = 0; i < 3; ++i) {
         double t = 0.0;
