@@ -7,11 +7,13 @@
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/support/atomic_file.h"
+#include "pine/support/folder_lock.h"
 #include "pine/support/progress.h"
 #include "pine/support/tool_main.h"
 
 #include <CLI/CLI.hpp>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 
 #include <algorithm>
@@ -39,6 +41,17 @@ struct Output {
     bool treeFrame = true;
 };
 
+/// Writes `text` to `file` atomically in the folder's turn (io::FolderLock, as the grids are):
+/// the temporaries a killed bake left are removed, a live one's never are.
+void writeInTurn(const fs::path& file, const std::string& text)
+{
+    tbb::this_task_arena::isolate([&] {
+        const io::FolderLock turn(io::FolderLock::of(file));
+        io::removeStaleTemporaries(file);
+        io::writeTextAtomically(file, text);
+    });
+}
+
 /// The mesh of the trunk and branches beside a tree's grids.
 fs::path meshBeside(const fs::path& grids)
 {
@@ -58,7 +71,7 @@ bake::ProxyInstance bakeTree(const scenes::Scene& scene, const fs::path& sceneFi
     const bake::TreeGrids grids = bake::bakeBoughs(boughs, settings);
     bake::FileLayout layout{output.unit, std::nullopt};
     if (output.treeFrame) layout.treeFrame = bake::treeFrame(placement);
-    io::writeTextAtomically(meshBeside(out), bake::branchMeshObj(tree, layout));
+    writeInTurn(meshBeside(out), bake::branchMeshObj(tree, layout));
     bake::writeTreeGrids(grids, out,
                          {sceneFile.string(), int(index), placement.seed, bake::treeDigest(boughs)},
                          layout);
@@ -153,8 +166,8 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
     });
     progress.finish();
     // Last: a list names only files already in place.
-    io::writeTextAtomically(
-        listFile, bake::instanceList(sceneFile.string(), output.unit, instances).dump(1) + "\n");
+    writeInTurn(listFile,
+                bake::instanceList(sceneFile.string(), output.unit, instances).dump(1) + "\n");
     summarize(totals, start);
     return 0;
 }

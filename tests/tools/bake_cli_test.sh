@@ -69,8 +69,13 @@ for f in b.vdb b.vdb.json b.obj; do [ -s "$work/$f" ] || fail "missing output $f
 grep -q "1 tree, [1-9][0-9]* voxels, [1-9][0-9]* bytes" "$work/err" || fail "no summary line: $(cat "$work/err")"
 grep -q '"fnv1a64"' "$work/b.vdb.json" || fail "manifest lacks fnv1a64"
 
-# All trees of a scene, in parallel: tree_000.vdb ... and a summary line last.
+# All trees of a scene, in parallel: tree_000.vdb ... and a summary line last. The temporaries
+# a killed bake left (of every file it writes) are removed.
 mkdir "$work/forest"
+for stale in .tree_000.vdb.tmp-0123456789abcdef .tree_001.obj.tmp-0123456789abcdef \
+             .instances.json.tmp-fedcba9876543210 .tree_002.vdb.json.tmp-00000000000000aa; do
+    echo half >"$work/forest/$stale"
+done
 "$bake" scene "$src/scenes/three-firs.json" --voxel-size 2 --levels 2 --out-dir "$work/forest" 2>"$work/err" \
     || fail "bake scene of three-firs.json failed: $(tail -1 "$work/err")"
 for f in tree_000.vdb tree_000.vdb.json tree_000.obj tree_002.vdb tree_002.vdb.json instances.json; do
