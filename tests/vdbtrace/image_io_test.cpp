@@ -135,6 +135,7 @@ TEST_F(ImageIo, ExrRoundTripIsBitExact)
                                {"renderTimeSeconds", 12.5f},
                                {"samplesPerPixel", 16},
                                {"worldToCamera", camera},
+                               {"pine:grid_to_world", camera},
                                {"settings", std::string(300, 'x') + " with spaces, ümlauts"}};
     const fs::path path = dir / "frame.exr";
     pine::vdbtrace::writeExr(image, path, metadata);

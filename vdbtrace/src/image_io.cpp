@@ -346,14 +346,14 @@ Image readExr(const std::filesystem::path& path, Metadata* metadata)
         for (const auto& attribute : spec.extra_attribs) {
             const std::string key = attribute.name().string();
             const OIIO::TypeDesc type = attribute.type();
-            if (isCameraMatrix(key) && type == OIIO::TypeDesc::TypeMatrix44) {
+            if (!isCameraMatrix(key) && (isStandardAttribute(key) || isReservedKey(key))) {
+                continue;
+            }
+            if (type == OIIO::TypeDesc::TypeMatrix44) {
                 Matrix44 matrix;
                 std::copy_n(static_cast<const float*>(attribute.data()), 16, &matrix.m[0][0]);
                 metadata->emplace_back(key, matrix);
-                continue;
-            }
-            if (isStandardAttribute(key) || isReservedKey(key)) continue;
-            if (type == OIIO::TypeDesc::STRING) {
+            } else if (type == OIIO::TypeDesc::STRING) {
                 metadata->emplace_back(key, attribute.get_string());
             } else if (type == OIIO::TypeDesc::INT) {
                 metadata->emplace_back(key, attribute.get_int());
