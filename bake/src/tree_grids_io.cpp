@@ -29,18 +29,6 @@ namespace pine::bake {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-constexpr const char* kFormatVersionKey = "pine:format_version";
-constexpr const char* kExtinctionLawKey = "pine:extinction_law";
-constexpr const char* kUnitsKey = "pine:units";
-constexpr const char* kFrameKey = "pine:frame";
-constexpr const char* kTreeBaseKey = "pine:tree_base_cm";
-constexpr const char* kTreeRotationKey = "pine:tree_rotation_rad";
-constexpr const char* kVoxelSizeKey = "pine:voxel_size_cm";
-
-/// The affine map from the scene's world (cm) into a file's world, as OpenVDB composes maps:
-/// row vectors, p' = p M, the translation in the last row.
 openvdb::Mat4d worldToFile(const FileLayout& layout)
 {
     const double inv = 1.0 / centimetresPer(layout.unit);
@@ -59,6 +47,16 @@ openvdb::Mat4d worldToFile(const FileLayout& layout)
     }
     return m;
 }
+
+namespace {
+
+constexpr const char* kFormatVersionKey = "pine:format_version";
+constexpr const char* kExtinctionLawKey = "pine:extinction_law";
+constexpr const char* kUnitsKey = "pine:units";
+constexpr const char* kFrameKey = "pine:frame";
+constexpr const char* kTreeBaseKey = "pine:tree_base_cm";
+constexpr const char* kTreeRotationKey = "pine:tree_rotation_rad";
+constexpr const char* kVoxelSizeKey = "pine:voxel_size_cm";
 
 bool isIdentity(const FileLayout& layout)
 {

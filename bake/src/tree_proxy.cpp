@@ -16,14 +16,9 @@ TreeFrame treeFrame(const scenes::TreePlacement& placement)
 
 Vec3 toFile(const Vec3& world_cm, const FileLayout& layout)
 {
-    Vec3 p = world_cm;
-    if (layout.treeFrame) {
-        const Vec3 q = p - layout.treeFrame->base_cm;
-        const double c = std::cos(layout.treeFrame->rotation_rad);
-        const double s = std::sin(layout.treeFrame->rotation_rad);
-        p = Vec3(c * q.x + s * q.y, -s * q.x + c * q.y, q.z);  // turned by -rotation
-    }
-    return p / centimetresPer(layout.unit);
+    const openvdb::Vec3d p =
+        worldToFile(layout).transform(openvdb::Vec3d(world_cm.x, world_cm.y, world_cm.z));
+    return Vec3(p.x(), p.y(), p.z());
 }
 
 namespace {

@@ -141,6 +141,10 @@ struct FileLayout {
     std::optional<TreeFrame> treeFrame;  ///< empty: the scene's world frame
 };
 
+/// The affine map from the scene's world (cm) into the world of a file laid out as `layout`,
+/// as OpenVDB composes maps: row vectors, p' = p M, the translation in the last row.
+openvdb::Mat4d worldToFile(const FileLayout& layout);
+
 /// Writes the grids atomically (temporary file in the same folder, synced, then renamed) with
 /// file metadata (format version, units, frame, extinction law and its formula, voxel size,
 /// scene, tree, seed, tree digest, tool version) and a manifest `PATH.json` beside it recording
