@@ -25,7 +25,6 @@
 #include "pine/vdbtrace/traced_scene.h"
 
 #include <CLI/CLI.hpp>
-#include <glm/geometric.hpp>
 #include <tbb/task_arena.h>
 
 
@@ -35,7 +34,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <limits>
 #include <map>
 #include <fstream>
 #include <iostream>
