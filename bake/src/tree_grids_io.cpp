@@ -411,7 +411,9 @@ ReadGrids parseTreeGrids(const std::string& bytes, const fs::path& path, bool ve
     }
     // What made them, where the file says (a grid from elsewhere may not).
     BakeProvenance& p = read.provenance;
-    if (const auto m = meta->getMetadata<openvdb::StringMetadata>("pine:scene")) p.scene = m->value();
+    if (const auto m = meta->getMetadata<openvdb::StringMetadata>("pine:scene")) {
+        p.scene = m->value();
+    }
     if (const auto m = meta->getMetadata<openvdb::Int32Metadata>("pine:tree")) p.tree = m->value();
     if (const auto m = meta->getMetadata<openvdb::Int64Metadata>("pine:seed")) {
         p.seed = unsigned(m->value());

@@ -77,7 +77,8 @@ bake::ProxyInstance bakeTree(const scenes::Scene& scene, const fs::path& sceneFi
                          layout);
     totals.trees += 1;
     totals.voxels += grids.density->activeVoxelCount();
-    totals.bytes += std::uint64_t(fs::file_size(out)) + std::uint64_t(fs::file_size(meshBeside(out)));
+    totals.bytes +=
+        std::uint64_t(fs::file_size(out)) + std::uint64_t(fs::file_size(meshBeside(out)));
     return {int(index),         out.filename().string(), meshBeside(out).filename().string(),
             placement.species, placement.seed,          layout.treeFrame};
 }
@@ -89,7 +90,8 @@ void summarize(const Totals& totals, std::chrono::steady_clock::time_point start
     const std::size_t trees = totals.trees.load();
     if (tool::quiet()) return;
     std::fprintf(stderr, "bake: %zu %s, %llu voxels, %llu bytes, %.2f s, peak %.0f MiB\n",
-                 trees, trees == 1 ? "tree" : "trees", static_cast<unsigned long long>(totals.voxels.load()),
+                 trees, trees == 1 ? "tree" : "trees",
+                 static_cast<unsigned long long>(totals.voxels.load()),
                  static_cast<unsigned long long>(totals.bytes.load()), seconds,
                  tool::peakMemoryMiB());
 }
