@@ -26,15 +26,14 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
     // Each point's transmittance so far.
     thread_local std::vector<double> T;
     T.assign(at.points.size(), 1.0);
-    bool dark = false;
     scene.bvh.query(ray, tMax, [&](std::uint32_t index) {
-        if (index == self || dark) return;
+        if (index == self) return true;
         const bool branch = scene.isBranch(index);
-        if (!branch && !throughBoughs) return;
+        if (!branch && !throughBoughs) return true;
         const Vec3 a = branch ? scene.branches[index].base_cm : scene.bough(index).base_cm;
         const Vec3 b = branch ? scene.branches[index].tip_cm : scene.bough(index).stripEnd_cm;
         Passage p;
-        if (!closestPassage(ray, a, b, p) || !(p.t < tMax)) return;
+        if (!closestPassage(ray, a, b, p) || !(p.t < tMax)) return true;
         // The points' lines pass the occluder shifted along its strip by their offsets (scaled
         // towards a point light), each read with the footprint's own width.
         const Vec3 n = stripAcross(glm::normalize(b - a), ray.direction);

@@ -6,6 +6,7 @@
 #include "pine/vdbtrace/geometry.h"
 
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -15,7 +16,8 @@ public:
     Bvh() = default;
     explicit Bvh(const std::vector<Aabb>& boxes);
 
-    /// Calls visit(index) for every primitive whose box the cone may touch before tMax.
+    /// Calls visit(index) for every primitive whose box the cone may touch before tMax, in a
+    /// fixed order. A visit that returns bool ends the query by returning false.
     template <class Visit>
     void query(const ConeRay& ray, double tMax, Visit&& visit) const
     {
@@ -28,7 +30,14 @@ public:
             double tIn, tOut;
             if (!intersectBox(ray, node.box, margin(ray, node.box), tMax, tIn, tOut)) continue;
             if (node.count > 0) {
-                for (std::uint32_t i = 0; i < node.count; ++i) visit(mIndices[node.first + i]);
+                for (std::uint32_t i = 0; i < node.count; ++i) {
+                    if constexpr (std::is_same_v<std::invoke_result_t<Visit, std::uint32_t>,
+                                                 bool>) {
+                        if (!visit(mIndices[node.first + i])) return;
+                    } else {
+                        visit(mIndices[node.first + i]);
+                    }
+                }
             } else if (top + 2 <= 64) {
                 stack[top++] = node.first;
                 stack[top++] = node.first + 1;
