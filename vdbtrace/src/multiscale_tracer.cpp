@@ -3,6 +3,7 @@
 #include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/effects_plan.h"
+#include "pine/vdbtrace/ground_hit.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/needle_layout.h"
 #include "pine/vdbtrace/render_driver.h"
@@ -75,6 +76,12 @@ private:
     RenderStats& mStats;
     SurfaceShading mSurfaces;
     std::vector<Fragment> mFragments;
+    struct Candidate {
+        double nearest;  ///< no fragment of the primitive lies nearer along the ray
+        std::uint32_t index;  ///< a BVH primitive or kGround
+    };
+    static constexpr std::uint32_t kGround = std::uint32_t(-1);
+    std::vector<Candidate> mCandidates;  ///< the primitives the ray may meet, nearest first
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
     std::vector<NeedleHit> mNeedleHits;               ///< a bough's needles on this ray
@@ -397,24 +404,70 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     mFragments.push_back(rear);
 }
 
+// No fragment of a primitive within `radius` of the segment a-b lies nearer along the ray
+// than this: its fragments lie within radius plus half the footprint of the segment (a level
+// 1 needle's within its cone's reach R plus the needle's radius of it), so within that of
+// its bounding sphere; the footprint's width is bounded at twice the sphere's far side.
+double nearestFragment(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius)
+{
+    const double centre = glm::dot(0.5 * (a + b) - ray.origin, ray.direction);
+    const double reach = 0.5 * glm::length(b - a) + radius;
+    return centre - reach - ray.width(std::max(0.0, centre + reach));
+}
+
 void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
 {
-    mFragments.clear();
-    Fragment ground;
-    const bool hasGround = mSurfaces.ground(ray, ground);
-    const double tMax = hasGround ? ground.t : std::numeric_limits<double>::infinity();
+    // Front to back: each primitive's fragments are made (and lit, shadow cones and all) only
+    // if the composite is not yet opaque at the nearest depth they can lie at, so that what
+    // lies behind opaque layers costs nothing. The composite receives the same fragments in
+    // the same order as if all were made and sorted.
+    double tGround;
+    Vec3 normal;
+    const bool hasGround = hitGround(mScene.scene->ground, ray, tGround, normal);
+    const double tMax = hasGround ? tGround : std::numeric_limits<double>::infinity();
+    mCandidates.clear();
     mScene.bvh.query(ray, tMax, [&](std::uint32_t index) {
-        if (!mScene.isBranch(index)) return addBough(ray, index);
-        Fragment f;
-        if (mSurfaces.branch(ray, index, tMax, f)) mFragments.push_back(f);
+        double nearest;
+        if (mScene.isBranch(index)) {
+            const TracedBranch& br = mScene.branches[index];
+            nearest = nearestFragment(ray, br.base_cm, br.tip_cm, br.radius_cm);
+        } else {
+            const TracedBough& b = mScene.bough(index);
+            nearest = nearestFragment(ray, b.base_cm, b.conesEnd_cm,
+                                      b.radius_cm + b.geometry.cone.needleRadius_cm);
+        }
+        mCandidates.push_back({nearest, index});
     });
-    if (hasGround) mFragments.push_back(ground);
-    std::sort(mFragments.begin(), mFragments.end(),
-              [](const Fragment& a, const Fragment& b) { return a.t < b.t; });
-    for (const Fragment& f : mFragments) {
-        if (composite.opaque()) break;
-        composite.add(f);
+    if (hasGround) mCandidates.push_back({tGround, kGround});
+    std::sort(mCandidates.begin(), mCandidates.end(),
+              [](const Candidate& x, const Candidate& y) {
+                  return x.nearest < y.nearest || (x.nearest == y.nearest && x.index < y.index);
+              });
+    mFragments.clear();
+    std::size_t done = 0;  // of mFragments, composited
+    // Composites the fragments made so far that lie before `depth`: none made later can.
+    const auto compositeBefore = [&](double depth) {
+        std::stable_sort(mFragments.begin() + done, mFragments.end(),
+                         [](const Fragment& a, const Fragment& b) { return a.t < b.t; });
+        while (done < mFragments.size() && mFragments[done].t <= depth &&
+               !composite.opaque()) {
+            composite.add(mFragments[done++]);
+        }
+    };
+    for (const Candidate& c : mCandidates) {
+        compositeBefore(c.nearest);
+        if (composite.opaque()) return;
+        if (c.index == kGround) {
+            Fragment ground;
+            if (mSurfaces.ground(ray, ground)) mFragments.push_back(ground);
+        } else if (!mScene.isBranch(c.index)) {
+            addBough(ray, c.index);
+        } else {
+            Fragment f;
+            if (mSurfaces.branch(ray, c.index, tMax, f)) mFragments.push_back(f);
+        }
     }
+    compositeBefore(std::numeric_limits<double>::infinity());
 }
 
 class Multiscale final : public ShadingMethod {
