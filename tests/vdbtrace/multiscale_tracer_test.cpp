@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -171,33 +172,45 @@ public:
         for (std::size_t i = 0; i < towardsLights.size(); ++i) {
             BoughLightTransfer light;
             light.transfer = {StripProfile::constant(0.1), StripProfile::constant(0.05)};
-            light.opacityFromLight = StripProfile::constant(0.5);
             s.lights.push_back(light);
         }
         return s;
     }
-    mutable int calls = 0;
+    StripProfile opacityFromLight(const TracedBough&, const Vec3&,
+                                  const LayerModel&) const override
+    {
+        ++opacityCalls;
+        return StripProfile::constant(0.5);
+    }
+    mutable std::atomic<int> calls = 0, opacityCalls = 0;
 };
 
-TEST(BoughLaw, OneCallOfTheLawGivesEveryBoughLevelQuantity)
+TEST(BoughLaw, EveryBoughLevelQuantityComesFromTheLawOnceAndOnlyWhenNeeded)
 {
     // The view opacity, each light's transfer and the opacity seen from the light all come
-    // from the law the bough was made with, in one call: level 3 shows exactly its numbers.
+    // from the law the bough was made with: level 3 shows exactly its numbers. Each is asked
+    // of the law once, when first needed: a bough is made without calling it.
     const FixedLaw law;
     SideOnBough s(law, R"("diffuse", "self_shadowing")");
-    EXPECT_EQ(law.calls, 1);
+    EXPECT_EQ(law.calls, 0);
+    EXPECT_EQ(law.opacityCalls, 0);
     const TracedBough& b = s.traced.boughs.front();
-    EXPECT_EQ(b.alpha.front.mean(), 0.3);
-    EXPECT_EQ(b.lighting.at(0).transfer.rear.mean(), 0.05);
-    EXPECT_EQ(b.lighting.at(0).opacityFromLight.mean(), 0.5);
     MultiscaleOptions level3;
     level3.forceLevel = 3;
     const RenderResult r = renderMultiscale(s.traced, level3);
+    EXPECT_EQ(law.calls, 1);  // from two threads, many pixels
+    EXPECT_EQ(law.opacityCalls, 0);  // no shadow cone meets the only bough
+    EXPECT_EQ(b.view().alpha.front.mean(), 0.3);
+    EXPECT_EQ(b.view().lighting.at(0).transfer.rear.mean(), 0.05);
+    EXPECT_EQ(b.opacityFromLight(0).mean(), 0.5);
+    EXPECT_EQ(b.opacityFromLight(0).mean(), 0.5);
+    EXPECT_EQ(law.calls, 1);
+    EXPECT_EQ(law.opacityCalls, 1);
     const float* centre = r.image.pixel(r.image.width / 2, r.image.height / 2);
     EXPECT_NEAR(centre[3], 1.0 - (1.0 - 0.3) * (1.0 - 0.2), 1e-6);
     // With self-shadowing each half reflects the law's transfer (not its opacity), the rear
     // seen through the front: G = (0.1 I_front + (1 - 0.3) 0.05 I_rear) a_G E_G / pi.
-    const BoughLighting& lit = b.lighting.at(0);
+    const BoughLighting& lit = b.view().lighting.at(0);
     const double E = s.traced.lights.at(0).power.y, albedo = b.needleAlbedo.y;
     const double expected =
         (0.1 * lit.front.diffuse + 0.7 * 0.05 * lit.rear.diffuse) * albedo / analytic::kPi * E;
@@ -283,7 +296,8 @@ TEST(MultiscaleTracer, BoughLevelCompositesSection66sHalves)
     options.forceLevel = 3;
     const RenderResult r = renderMultiscale(s.traced, options);
     const TracedBough& b = s.traced.boughs.front();
-    const double expected = 1.0 - (1.0 - b.alpha.front.mean()) * (1.0 - b.alpha.rear.mean());
+    const FrontRearProfile& alpha = b.view().alpha;
+    const double expected = 1.0 - (1.0 - alpha.front.mean()) * (1.0 - alpha.rear.mean());
     const float centre = r.image.pixel(r.image.width / 2, r.image.height / 2)[3];
     EXPECT_NEAR(centre, expected, 1e-6);
 }

@@ -93,13 +93,15 @@ bool chord(const TracedBough& b, const Vec3& d, const Vec3& across, int k, int p
 
 class ExactBoughLaw final : public BoughLaw {
 public:
+    BoughLawTraits traits() const override
+    {
+        return {RearComposite::Share, /*stripToConesEnd=*/true, /*shadesNeedles=*/true};
+    }
     BoughShading shade(const TracedBough& b, const Vec3& V,
                        const std::vector<Vec3>& towardsLights, const LayerModel& layers,
                        const BoughLawNeeds& needs) const override
     {
         BoughShading out;
-        out.rear = RearComposite::Share;
-        out.shadesNeedles = true;
         const Vec3 d = -V;
         const double phi = b.geometry.cone.aperture_rad;
         const double cotPhi = 1.0 / std::tan(phi), sinPhi = std::sin(phi), cosPhi = std::cos(phi);
@@ -171,24 +173,21 @@ public:
             return FrontRearProfile{StripProfile::sampled(front), StripProfile::sampled(rear)};
         };
         out.alpha = profiles(alpha[0], alpha[1]);
-        out.stripToConesEnd = true;
         for (std::size_t i = 0; i < lights; ++i) {
             BoughLightTransfer light;
             light.transfer = profiles(lit[0][i], lit[1][i]);
             light.diffuse = profiles(diffuse[0][i], diffuse[1][i]);
             light.specular = profiles(specular[0][i], specular[1][i]);
-            if (needs.shadowOpacity) {
-                light.opacityFromLight = opacityAlong(b, -towardsLights[i], layers);
-            }
             out.lights.push_back(light);
         }
         return out;
     }
 
-private:
-    // The whole bough's opacity for chords along d, across their strip.
-    static StripProfile opacityAlong(const TracedBough& b, const Vec3& d, const LayerModel& layers)
+    // The whole bough's opacity for chords along d = -towardsLight, across their strip.
+    StripProfile opacityFromLight(const TracedBough& b, const Vec3& towardsLight,
+                                  const LayerModel& layers) const override
     {
+        const Vec3 d = -towardsLight;
         const Vec3 across = stripAcross(b.axis, -d);
         std::vector<double> cells(kCells, 0.0);
         for (int k = 0; k < kCells; ++k) {

@@ -30,13 +30,18 @@ public:
             light.transfer = constant(
                 analytic::boughLinearLaw(b.geometry, analytic::boughView(phi, b.axis, L, V))
                     .transfer);
-            const analytic::FrontRear fromLight =
-                analytic::boughLinearLaw(b.geometry, analytic::boughView(phi, b.axis, L, L))
-                    .alphaView;
-            light.opacityFromLight = StripProfile::constant(fromLight.front + fromLight.rear);
             out.lights.push_back(light);
         }
         return out;
+    }
+    StripProfile opacityFromLight(const TracedBough& b, const Vec3& L,
+                                  const LayerModel&) const override
+    {
+        const analytic::FrontRear fromLight =
+            analytic::boughLinearLaw(b.geometry,
+                                     analytic::boughView(b.geometry.cone.aperture_rad, b.axis, L, L))
+                .alphaView;
+        return StripProfile::constant(fromLight.front + fromLight.rear);
     }
 };
 

@@ -223,8 +223,9 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
         // footprint (the exact law's shares), the layers keep their order and shading and
         // take the law's coverage.
         if (coverage < 1.0 && covered > 0.0 && b.rearComposite == RearComposite::Share) {
-            const double target = b.alpha.front.overFootprint(xi, b.radius_cm, w) +
-                                  b.alpha.rear.overFootprint(xi, b.radius_cm, w);
+            const FrontRearProfile& alpha = b.view().alpha;
+            const double target = alpha.front.overFootprint(xi, b.radius_cm, w) +
+                                  alpha.rear.overFootprint(xi, b.radius_cm, w);
             const double k = std::min(target, 0.999) / covered;
             double was = 0.0, before = 0.0;  // covered in front, as composited and as scaled
             for (NeedleHit& h : mNeedleHits) {
@@ -343,7 +344,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     // over the footprint at the chord's signed offset from the axis.
     ++mStats.boughHits;
     const double R = b.radius_cm;
-    const double frontAlpha = b.alpha.front.overFootprint(xi, R, w);
+    const BoughView& view = b.view();
+    const double frontAlpha = view.alpha.front.overFootprint(xi, R, w);
     // What the rear's share is divided by to composite behind the front (bough_law.h).
     const double behindFront =
         b.rearComposite == RearComposite::Share ? 1.0 - frontAlpha : 1.0;
@@ -352,16 +354,16 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     };
     const double tMid = 0.5 * (tIn + tOut);
     Fragment front{tIn, frontAlpha, Vec3(0.0), Vec3(0.0), 3, true, b.tree};
-    Fragment rear{tMid, rearPart(b.alpha.rear), Vec3(0.0), Vec3(0.0), 3, true, b.tree};
+    Fragment rear{tMid, rearPart(view.alpha.rear), Vec3(0.0), Vec3(0.0), 3, true, b.tree};
     // The light at the chord's middle, or with shadow_origin "axis" where the ray passes the
     // axis.
     const double tLight = mScene.shadowsFromNeedles ? tMid : p.t;
     mLight.resize(mScene.lights.size());
     for (std::size_t i = 0; i < mLight.size(); ++i) {
-        const BoughLighting& lit = b.lighting[i];
+        const BoughLighting& lit = view.lighting[i];
         mLight[i] = mSurfaces.unshadowed(i, ray.origin + tLight * ray.direction);
         // Without self-shadowing the whole opacity reflects; with it, the law's transfer.
-        const FrontRearProfile& transfer = mPlan.selfShadowing ? lit.transfer : b.alpha;
+        const FrontRearProfile& transfer = mPlan.selfShadowing ? lit.transfer : view.alpha;
         const double tf = transfer.front.overFootprint(xi, R, w);
         const double tr = rearPart(transfer.rear);
         mStats.selfShadowEvaluations += mPlan.selfShadowing ? 2 : 0;

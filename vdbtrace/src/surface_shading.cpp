@@ -42,16 +42,17 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         const double scale = scene.lights[light].directional ? 1.0 : p.t / tMax;
         const double along = glm::dot(at.across, n) * scale;
         const double w = pointWidth * ray.width(p.t);
-        dark = true;
+        bool dark = true;  // every point: nothing further shows
         for (std::size_t k = 0; k < T.size(); ++k) {
             const double g = gap + along * at.points[k].offset_cm;
             const double alpha =
                 branch ? stripCoverage(g, scene.branches[index].radius_cm, w)
-                       : scene.bough(index).lighting[light].opacityFromLight.overFootprint(
+                       : scene.bough(index).opacityFromLight(light).overFootprint(
                              g, scene.bough(index).radius_cm, w);
             T[k] *= 1.0 - alpha;
             dark = dark && T[k] < 1e-4;
         }
+        return !dark;
     });
     double sum = 0.0, weight = 0.0;
     for (std::size_t k = 0; k < T.size(); ++k) {

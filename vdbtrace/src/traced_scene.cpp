@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 
 namespace pine::vdbtrace {
@@ -81,6 +82,53 @@ Vec3 stripAcross(const Vec3& axis, const Vec3& towards)
     return n > 1e-9 ? c / n : analytic::anyPerpendicular(axis);
 }
 
+struct BoughLawEvaluation {
+    const BoughLaw* law = nullptr;
+    const LayerModel* layers = nullptr;
+    BoughLawNeeds needs;
+    Vec3 V{0.0};                ///< unit, from the bough's centre to the camera
+    std::vector<Vec3> towards;  ///< unit, from the bough's centre to each light
+    std::once_flag viewOnce;
+    BoughView view;
+    std::unique_ptr<std::once_flag[]> fromLightOnce;  ///< one per light
+    std::vector<StripProfile> fromLight;
+};
+
+const BoughView& TracedBough::view() const
+{
+    BoughLawEvaluation& e = *law;
+    std::call_once(e.viewOnce, [&] {
+        const BoughShading shading = e.law->shade(*this, e.V, e.towards, *e.layers, e.needs);
+        if (shading.lights.size() != e.towards.size()) {
+            throw std::logic_error("a bough law shaded another number of lights");
+        }
+        e.view.alpha = shading.alpha;
+        const analytic::ConeGeometry& cone = geometry.cone;
+        for (std::size_t i = 0; i < e.towards.size(); ++i) {
+            const auto sums = analytic::coneSums(
+                cone, analytic::coneIntegrals(cone.aperture_rad, axis, e.towards[i], e.V, exponent),
+                exponent);
+            BoughLighting lit;
+            lit.front = analytic::meanReflectance(sums.front);
+            lit.rear = analytic::meanReflectance(sums.rear);
+            lit.transfer = shading.lights[i].transfer;
+            lit.diffuse = shading.lights[i].diffuse;
+            lit.specular = shading.lights[i].specular;
+            e.view.lighting.push_back(lit);
+        }
+    });
+    return e.view;
+}
+
+const StripProfile& TracedBough::opacityFromLight(std::size_t light) const
+{
+    BoughLawEvaluation& e = *law;
+    std::call_once(e.fromLightOnce[light], [&] {
+        e.fromLight[light] = e.law->opacityFromLight(*this, e.towards[light], *e.layers);
+    });
+    return e.fromLight[light];
+}
+
 TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
                             const std::vector<Light>& lights, const BoughLaw& law,
                             const LayerModel& layers, const BoughLawNeeds& needs)
@@ -101,36 +149,28 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
     b.tree = d.tree;
     b.exponent = d.exponent;
     b.seed = d.seed;
+    const BoughLawTraits traits = law.traits();
+    b.rearComposite = traits.rear;
+    b.stripEnd_cm = traits.stripToConesEnd ? b.conesEnd_cm : b.tip_cm;
+    b.shadesNeedles = traits.shadesNeedles;
 
     // Directions from the bough's centre: to the camera (V) and to each light (L).
+    auto e = std::make_shared<BoughLawEvaluation>();
+    e->law = &law;
+    e->layers = &layers;
+    e->needs = needs;
     const Vec3 centre = 0.5 * (b.base_cm + b.tip_cm);
-    const Vec3 V = glm::normalize(eye_cm - centre);
-    std::vector<Vec3> towards;
+    e->V = glm::normalize(eye_cm - centre);
     for (const Light& light : lights) {
         Vec3 L, irradiance;
         double distance;
         light.at(centre, L, distance, irradiance);
-        towards.push_back(L);
+        e->towards.push_back(L);
     }
-    b.across = stripAcross(b.axis, V);
-    const BoughShading shading = law.shade(b, V, towards, layers, needs);
-    b.alpha = shading.alpha;
-    b.rearComposite = shading.rear;
-    b.stripEnd_cm = shading.stripToConesEnd ? b.conesEnd_cm : b.tip_cm;
-    b.shadesNeedles = shading.shadesNeedles;
-    for (std::size_t i = 0; i < lights.size(); ++i) {
-        const auto sums = analytic::coneSums(
-            cone, analytic::coneIntegrals(cone.aperture_rad, b.axis, towards[i], V, b.exponent),
-            b.exponent);
-        BoughLighting lit;
-        lit.front = analytic::meanReflectance(sums.front);
-        lit.rear = analytic::meanReflectance(sums.rear);
-        lit.transfer = shading.lights[i].transfer;
-        lit.diffuse = shading.lights[i].diffuse;
-        lit.specular = shading.lights[i].specular;
-        lit.opacityFromLight = shading.lights[i].opacityFromLight;
-        b.lighting.push_back(lit);
-    }
+    e->fromLightOnce = std::make_unique<std::once_flag[]>(lights.size());
+    e->fromLight.resize(lights.size());
+    b.across = stripAcross(b.axis, e->V);
+    b.law = std::move(e);
     return b;
 }
 

@@ -1,7 +1,7 @@
 // Level 3's law: how a bough, shaded as a volume (paper section 6), covers the pixel and passes
 // light. A law is a type registered by name in src/bough_laws.cpp and chosen once per render
 // (the scene's render.bough_law): the view opacity, each light's transfer and each light's
-// opacity all come from the same law, in one call, so that no render mixes two laws. Each is a
+// opacity all come from the same law, so that no render mixes two laws. Each is a
 // profile across the bough's strip (strip_profile.h): the paper's laws are one value for the
 // whole strip, the exact law a function of the chord's offset.
 #pragma once
@@ -30,57 +30,64 @@ enum class RearComposite {
     Share,
 };
 
-/// A bough as one light sees it, under a law.
+/// A bough as one light sees it with the camera where it is, under a law.
 struct BoughLightTransfer {
     /// Radiance of each half per unit I^cyl of its face and unit irradiance, with the
     /// bough's self-shadowing (section 6.6's I_FV / I^cyl and I_RV / I^cyl), across the
     /// view's strip.
     FrontRearProfile transfer;
-    /// With BoughShading::shadesNeedles: what each half reflects per unit irradiance, each
+    /// With BoughLawTraits::shadesNeedles: what each half reflects per unit irradiance, each
     /// needle by eqs. 1-2 at its own direction (diffuse per unit albedo / pi, specular per
     /// unit specular weight), with self-shadowing when asked: in place of the transfer times
     /// the face's mean I^cyl, which holds only where the light reaches every needle alike.
     FrontRearProfile diffuse, specular;
-    /// The whole bough's opacity seen from the light, across the light's strip: what its
-    /// shadow takes from light crossing it.
-    StripProfile opacityFromLight;
 };
 
 /// What a render needs of a bough law: a law may skip what is not needed.
 struct BoughLawNeeds {
-    bool transfer = true;        ///< self-shadowing: each light's transfer
-    bool shadowOpacity = true;   ///< shadows: each light's opacity
-    bool diffuse = true;         ///< the diffuse reflectance, for a law that shades needles
-    bool specular = true;        ///< the specular one
+    bool transfer = true;  ///< self-shadowing: each light's transfer
+    bool diffuse = true;   ///< the diffuse reflectance, for a law that shades needles
+    bool specular = true;  ///< the specular one
     /// What a render of the effects `plan` reads.
     static BoughLawNeeds from(const EffectsPlan& plan)
     {
-        return {plan.selfShadowing, plan.shadowRays, plan.diffuse, plan.specular};
+        return {plan.selfShadowing, plan.diffuse, plan.specular};
     }
 };
 
-/// A bough under a law, for one camera position and the scene's lights.
-struct BoughShading {
-    FrontRearProfile alpha;  ///< opacity of each half seen from the camera, across its strip
+/// How a law's profiles are drawn and read: the same for every bough.
+struct BoughLawTraits {
     RearComposite rear = RearComposite::Own;
     /// The strip the profiles are drawn on runs from the base to the cones' end (where the last
     /// cone's needles end), not to the tip: level 3 and shadows then draw it so.
     bool stripToConesEnd = false;
     /// Each light's `diffuse` and `specular` profiles are set: level 3 reflects them.
     bool shadesNeedles = false;
+};
+
+/// A bough under a law, for one camera position and the scene's lights.
+struct BoughShading {
+    FrontRearProfile alpha;  ///< opacity of each half seen from the camera, across its strip
     std::vector<BoughLightTransfer> lights;  ///< one per light, in the scene's order
 };
 
 class BoughLaw {
 public:
     virtual ~BoughLaw() = default;
+    virtual BoughLawTraits traits() const { return {}; }
     /// Bough b (its frame, geometry, R and A set), seen along unit V (towards the camera),
     /// its strip's offsets measured along b.across, and lit along each unit direction of
-    /// `towardsLights`, whose strips' offsets are along normalize(b.axis x L). `layers` is the
-    /// render's layer model, for a law that crosses the layers.
+    /// `towardsLights`. `layers` is the render's layer model, for a law that crosses the
+    /// layers.
     virtual BoughShading shade(const TracedBough& b, const Vec3& V,
                                const std::vector<Vec3>& towardsLights, const LayerModel& layers,
                                const BoughLawNeeds& needs) const = 0;
+    /// The whole bough's opacity seen along unit `towardsLight` (from the light), across the
+    /// light's strip, offsets along normalize(b.axis x towardsLight): what its shadow takes
+    /// from light crossing it. The same law as shade()'s, asked apart: a render needs it only
+    /// of the boughs a shadow cone meets.
+    virtual StripProfile opacityFromLight(const TracedBough& b, const Vec3& towardsLight,
+                                          const LayerModel& layers) const = 0;
 };
 
 /// The law registered as `name`; throws InputError naming the registered ones.

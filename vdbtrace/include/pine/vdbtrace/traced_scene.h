@@ -14,6 +14,7 @@
 #include "pine/vdbtrace/strip_profile.h"
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -47,8 +48,16 @@ struct BoughLighting {
     analytic::FaceReflectance front, rear;  ///< I^cyl of each face (diffuse, specular)
     FrontRearProfile transfer;              ///< the bough law's, with self-shadowing
     FrontRearProfile diffuse, specular;     ///< the law's, where it shades needles
-    StripProfile opacityFromLight;          ///< the bough law's: the whole bough from the light
 };
+
+/// What level 3 draws of a bough seen from the camera, under the bough law.
+struct BoughView {
+    FrontRearProfile alpha;              ///< the law's opacity of each half
+    std::vector<BoughLighting> lighting;  ///< one per light
+};
+
+/// What a bough's law profiles are computed from, and them once computed (traced_scene.cpp).
+struct BoughLawEvaluation;
 
 /// What the scene says of one bough: what makeTracedBough prepares.
 struct BoughDescription {
@@ -77,12 +86,19 @@ struct TracedBough {
     /// Unit, across the strip the bough covers seen from the camera: the sign of a chord's
     /// offset from the axis (stripAcross(axis, V)).
     Vec3 across{0.0};
-    FrontRearProfile alpha;  ///< the bough law's opacity of each half seen from the camera
     RearComposite rearComposite = RearComposite::Own;  ///< how the law's rear half composites
     bool shadesNeedles = false;  ///< level 3 reflects the law's diffuse and specular profiles
     unsigned seed = 0;          ///< drives the needles' azimuths at level 1
     int tree = -1;              ///< index of its tree in the scene's trees
-    std::vector<BoughLighting> lighting;  ///< one per light
+
+    /// The bough law's profiles seen from the camera, computed on first use, once, from any
+    /// thread: a bough that no cone meets at level 3 never pays for them.
+    const BoughView& view() const;
+    /// The law's opacity of the whole bough seen from light `light`, across the light's strip
+    /// (what its shadow takes from light crossing it): on first use, once, as view().
+    const StripProfile& opacityFromLight(std::size_t light) const;
+    /// Their inputs and values, shared by copies of this bough, which must not change it.
+    std::shared_ptr<BoughLawEvaluation> law;
 };
 
 /// Unit, orthogonal to the unit `axis` and to `towards`: the direction across the strip a
@@ -90,9 +106,10 @@ struct TracedBough {
 Vec3 stripAcross(const Vec3& axis, const Vec3& towards);
 
 /// The bough of `description` prepared for a camera at `eye_cm` and `lights` under `law` and
-/// `layers`: its frame, R and A, and everything that depends only on directions from its
-/// centre (the cone level's face reflectances, the law's opacities and transfers), once per
-/// bough and light. @throw std::invalid_argument for a bough of zero length.
+/// `layers`: its frame, R and A; what depends only on directions from its centre (the cone
+/// level's face reflectances, the law's opacities and transfers) is computed on first use,
+/// once per bough and light. `law` and `layers` must outlive the bough. @throw
+/// std::invalid_argument for a bough of zero length.
 TracedBough makeTracedBough(const BoughDescription& description, const Vec3& eye_cm,
                             const std::vector<Light>& lights, const BoughLaw& law,
                             const LayerModel& layers, const BoughLawNeeds& needs = {});
