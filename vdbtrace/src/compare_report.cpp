@@ -177,8 +177,9 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
     for (double h : st.voxelSizes_cm) s << ' ' << formatNumber(h);
     s << " cm, " << st.subpixels * st.subpixels << " rays per pixel; multiscale: levels forced "
       << "to 1, 2, 3 and automatic\n";
-    s << "- scene build (trees grown, BVH, per-bough shading): "
-      << formatNumber(run.buildSeconds, 3) << " s, once, excluded from every time below\n\n";
+    s << "- scene build (trees grown, BVH): " << formatNumber(run.buildSeconds, 3)
+      << " s, excluded from every time below; the multiscale times include the bough law's "
+         "per-bough profiles, computed as the render first needs them\n\n";
     s << "## Error against time\n\n"
          "Seconds: wall clock of each render alone, including what the method alone needs "
          "first (prep: the geometry's Embree BVH, the reference's bake and light grids). Errors: "

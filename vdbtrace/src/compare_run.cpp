@@ -84,7 +84,11 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
     }
     for (int level : st.levels) {
         s.multiscale.forceLevel = level;
-        measure(render(traced, "multiscale", "multiscale",
+        // The bough law's profiles are computed as a render first needs them (traced_scene.h)
+        // and belong to the multiscale method's time: each row starts from a scene of its own,
+        // so that none inherits another's.
+        const TracedScene fresh = buildTracedScene(scene);
+        measure(render(fresh, "multiscale", "multiscale",
                        level ? "L" + std::to_string(level) : "auto", s));
     }
     return run;

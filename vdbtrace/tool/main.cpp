@@ -388,8 +388,10 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model)
     const auto share = [&](int level) { return double(st.pixelsPerLevel[level]) / pixels; };
     std::cout << "scene " << sceneFile.string() << " " << scene.camera.width << "x"
               << scene.camera.height << ", threads " << tbb::this_task_arena::max_concurrency()
-              << "\nscene build seconds (trees grown, BVH, per-bough shading) " << buildSeconds
-              << "\nrender seconds " << r.seconds << "\ncone rays per second " << pixels / r.seconds
+              << "\nscene build seconds (trees grown, BVH) " << buildSeconds
+              << "\nrender seconds (with the bough law's profiles, computed on first use) "
+              << r.seconds
+              << "\ncone rays per second " << pixels / r.seconds
               << "\npeak memory MiB " << tool::peakMemoryMiB() << "\nshare of pixels: none "
               << share(0) << ", needle " << share(1) << ", cone " << share(2) << ", bough "
               << share(3) << '\n';

@@ -42,7 +42,7 @@ struct CompareRow {
 
 struct CompareRun {
     std::vector<CompareRow> rows;  ///< the truth first
-    double buildSeconds = 0.0;     ///< trees grown, BVH, per-bough shading: once, not in rows
+    double buildSeconds = 0.0;     ///< trees grown, BVH: not in rows
 };
 
 /// A line of progress for a person (one per render).
