@@ -7,12 +7,6 @@
 
 namespace pine::vdbtrace {
 
-double Bvh::margin(const ConeRay& ray, const Aabb& box)
-{
-    const double far = glm::length(box.centre() - ray.origin) + 0.5 * glm::length(box.hi - box.lo);
-    return 0.5 * ray.width(far);
-}
-
 Bvh::Bvh(const std::vector<Aabb>& boxes)
 {
     if (boxes.empty()) return;
@@ -34,6 +28,8 @@ void Bvh::build(const std::vector<Aabb>& boxes, std::uint32_t node, std::uint32_
         centres.grow(boxes[mIndices[i]].centre());
     }
     mNodes[node].box = box;
+    mNodes[node].centre = box.centre();
+    mNodes[node].halfDiagonal = 0.5 * glm::length(box.hi - box.lo);
     if (count <= 4) {
         mNodes[node].first = first;
         mNodes[node].count = count;

@@ -5,6 +5,10 @@
 
 #include "pine/vdbtrace/geometry.h"
 
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
 #include <vector>
@@ -22,13 +26,13 @@ public:
     void query(const ConeRay& ray, double tMax, Visit&& visit) const
     {
         if (mNodes.empty()) return;
+        const Slabs slabs(ray);
         std::uint32_t stack[64];
         int top = 0;
         stack[top++] = 0;
         while (top > 0) {
             const Node& node = mNodes[stack[--top]];
-            double tIn, tOut;
-            if (!intersectBox(ray, node.box, margin(ray, node.box), tMax, tIn, tOut)) continue;
+            if (!slabs.meets(ray, node, tMax)) continue;
             if (node.count > 0) {
                 for (std::uint32_t i = 0; i < node.count; ++i) {
                     if constexpr (std::is_same_v<std::invoke_result_t<Visit, std::uint32_t>,
@@ -51,11 +55,45 @@ public:
 private:
     struct Node {
         Aabb box;
-        std::uint32_t first = 0;  ///< leaf: first index; inner: first child
-        std::uint32_t count = 0;  ///< leaf: number of primitives; inner: 0
+        Vec3 centre{0.0};           ///< of the box
+        double halfDiagonal = 0.0;  ///< of the box
+        std::uint32_t first = 0;    ///< leaf: first index; inner: first child
+        std::uint32_t count = 0;    ///< leaf: number of primitives; inner: 0
     };
-    /// Half the footprint's width at the box's far side (conservatively).
-    static double margin(const ConeRay& ray, const Aabb& box);
+    /// A ray's slab test, its reciprocal direction computed once per query: the node's box
+    /// grown by half the footprint's width at its far side (conservatively), entered before
+    /// tMax.
+    struct Slabs {
+        Vec3 inverse{0.0};
+        bool parallel[3] = {false, false, false};
+        explicit Slabs(const ConeRay& ray)
+        {
+            for (int i = 0; i < 3; ++i) {
+                parallel[i] = std::abs(ray.direction[i]) < 1e-300;
+                inverse[i] = parallel[i] ? 0.0 : 1.0 / ray.direction[i];
+            }
+        }
+        bool meets(const ConeRay& ray, const Node& node, double tMax) const
+        {
+            const double margin =
+                0.5 * ray.width(glm::length(node.centre - ray.origin) + node.halfDiagonal);
+            double t0 = 0.0, t1 = tMax;
+            for (int i = 0; i < 3; ++i) {
+                const double lo = node.box.lo[i] - margin, hi = node.box.hi[i] + margin;
+                const double o = ray.origin[i];
+                if (parallel[i]) {
+                    if (o < lo || o > hi) return false;
+                    continue;
+                }
+                double a = (lo - o) * inverse[i], b = (hi - o) * inverse[i];
+                if (a > b) std::swap(a, b);
+                t0 = std::max(t0, a);
+                t1 = std::min(t1, b);
+                if (t0 > t1) return false;
+            }
+            return true;
+        }
+    };
     void build(const std::vector<Aabb>& boxes, std::uint32_t node, std::uint32_t first,
                std::uint32_t count);
 
