@@ -37,9 +37,9 @@ public:
     StripProfile opacityFromLight(const TracedBough& b, const Vec3& L,
                                   const LayerModel&) const override
     {
+        const double phi = b.geometry.cone.aperture_rad;
         const analytic::FrontRear fromLight =
-            analytic::boughLinearLaw(b.geometry,
-                                     analytic::boughView(b.geometry.cone.aperture_rad, b.axis, L, L))
+            analytic::boughLinearLaw(b.geometry, analytic::boughView(phi, b.axis, L, L))
                 .alphaView;
         return StripProfile::constant(fromLight.front + fromLight.rear);
     }

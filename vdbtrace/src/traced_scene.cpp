@@ -102,11 +102,13 @@ const BoughView& TracedBough::view() const
         if (shading.lights.size() != e.towards.size()) {
             throw std::logic_error("a bough law shaded another number of lights");
         }
-        e.view.alpha = shading.alpha;
+        BoughView view;
+        view.alpha = shading.alpha;
         const analytic::ConeGeometry& cone = geometry.cone;
         for (std::size_t i = 0; i < e.towards.size(); ++i) {
             const auto sums = analytic::coneSums(
-                cone, analytic::coneIntegrals(cone.aperture_rad, axis, e.towards[i], e.V, exponent),
+                cone,
+                analytic::coneIntegrals(cone.aperture_rad, axis, e.towards[i], e.V, exponent),
                 exponent);
             BoughLighting lit;
             lit.front = analytic::meanReflectance(sums.front);
@@ -114,8 +116,9 @@ const BoughView& TracedBough::view() const
             lit.transfer = shading.lights[i].transfer;
             lit.diffuse = shading.lights[i].diffuse;
             lit.specular = shading.lights[i].specular;
-            e.view.lighting.push_back(lit);
+            view.lighting.push_back(lit);
         }
+        e.view = std::move(view);  // only whole: a throw leaves the flag unset to try again
     });
     return e.view;
 }
