@@ -92,14 +92,20 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
     const double dt = dh / (4.0 * (1.0 + cotPhi));
     const double coverageTimesRho = cone.needlesPerCone * cone.needleRadius_cm / analytic::kPi;
     const double layersPerCm = 1.0 / (dh * sinPhi);  // |grad g| / dh
-    // g and sigma at o + t d.
+    // g and sigma at o + t d. Along the line h and the offset from the axis are linear in t;
+    // |d x a| = sqrt(1 - (d . a)^2) for the needle direction a = cos(phi) axis + sin(phi)
+    // radial.
+    const Vec3 r0 = o - b.base_cm;
+    const double h0 = glm::dot(r0, b.axis), dAlong = glm::dot(d, b.axis);
+    const Vec3 across0 = r0 - h0 * b.axis, dAcross = d - dAlong * b.axis;
     const auto at = [&](double t, double& g, double& sigma) {
-        double rho;
-        Vec3 radial;
-        g = coneHeight(b, cotPhi, o + t * d, &rho, &radial);
-        const Vec3 needle = rho > 0.0 ? cosPhi * b.axis + sinPhi * radial : b.axis;
+        const Vec3 across = across0 + t * dAcross;
+        const double rho = glm::length(across);
+        g = h0 + t * dAlong - rho * cotPhi;
+        const double dNeedle =
+            rho > 0.0 ? cosPhi * dAlong + sinPhi * glm::dot(d, across) / rho : dAlong;
         const double coverage = rho > coverageTimesRho ? coverageTimesRho / rho : 1.0;
-        sigma = coverage * glm::length(glm::cross(d, needle)) * layersPerCm;
+        sigma = coverage * std::sqrt(std::max(0.0, 1.0 - dNeedle * dNeedle)) * layersPerCm;
     };
     const auto bandOf = [&](double g) { return long(std::floor(g / dh + 0.5)); };
 
