@@ -107,4 +107,11 @@ double peakMemoryMiB()
     return double(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
 }
 
+double processCpuSeconds()
+{
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 }  // namespace pine::tool

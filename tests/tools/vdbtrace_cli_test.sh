@@ -191,8 +191,38 @@ odd="$work/a';touch \"$work/INJECTED\";'b"
 [ -s "$odd/report.md" ] || fail "compare wrote no report into $odd"
 [ ! -e "$work/INJECTED" ] || fail "a folder name ran as a shell command"
 
+# bench: multiscale and geometry timed in one run; the JSON holds what the lines say, the
+# ratio is of the two medians, each median within its runs' least and most.
+/usr/bin/python3 -c 'import json, sys
+scene = json.load(open(sys.argv[1]))
+scene["camera"]["resolution"] = [48, 36]
+json.dump(scene, open(sys.argv[2], "w"))' "$src/scenes/three-firs.json" "$work/small-firs.json"
+"$vdbtrace" bench "$work/small-firs.json" --repeat 3 --geometry-samples 2 \
+    --json "$work/bench.json" >"$work/bench.out" 2>"$work/err" \
+    || fail "bench: $(tail -1 "$work/err")"
+/usr/bin/python3 - "$work/bench.json" "$work/bench.out" <<'PY' \
+    || fail "bench JSON: $(cat "$work/bench.out")"
+import json, math, sys
+j = json.load(open(sys.argv[1]))
+out = open(sys.argv[2]).read()
+for m in ("multiscale", "geometry"):
+    r = j[m]
+    assert 0 < r["cpu_seconds_min"] <= r["cpu_seconds"] <= r["cpu_seconds_max"], r
+    assert r["wall_seconds"] > 0, r
+assert j["geometry"]["samples_per_pixel"] == 2 and j["repeats"] == 3
+ratio = j["multiscale"]["cpu_seconds"] / j["geometry"]["cpu_seconds"]
+assert math.isclose(j["cpu_ratio_multiscale_over_geometry"], ratio, rel_tol=1e-12), ratio
+assert j["multiscale"]["model"]["bough_law"] == "exact", j["multiscale"]["model"]
+assert abs(sum(j["multiscale"]["pixel_share"].values()) - 1) < 1e-9
+assert j["resolution"] == [48, 36] and j["startup_cpu_seconds"] > 0
+assert "CPU ratio multiscale / geometry" in out and "geometry 2 spp render" in out, out
+PY
+expect_error "bench JSON into a missing folder" 2 "no/such" -- \
+    bench "$work/small-firs.json" --json "$work/no/such/b.json"
+
 "$vdbtrace" --help >/dev/null || fail "--help"
 "$vdbtrace" render --help >/dev/null || fail "render --help"
+"$vdbtrace" bench --help >/dev/null || fail "bench --help"
 
 echo "vdbtrace cli: $failures failed"
 [ "$failures" -eq 0 ]

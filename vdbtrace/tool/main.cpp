@@ -362,59 +362,143 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     return 0;
 }
 
-// Grows the trees (timed into `buildSeconds`), then renders: the result's `seconds` is the
-// render alone.
-vdbtrace::RenderResult timed(const scenes::Scene& scene, const std::string& label,
-                             double* buildSeconds = nullptr)
+std::string machineDescription();
+
+// One timed render of `method`: the scene built (trees grown, BVH: not timed), then the render,
+// its wall and CPU seconds (the process's, all threads: a bough law's profiles and a method's
+// own preparation, as the geometry's Embree BVH, included).
+struct BenchRun {
+    vdbtrace::RenderResult result;
+    double wallSeconds = 0.0, cpuSeconds = 0.0, buildSeconds = 0.0;
+};
+
+BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
+                  const vdbtrace::MethodSettings& settings, const std::string& label)
 {
-    const auto start = std::chrono::steady_clock::now();
+    using Clock = std::chrono::steady_clock;
+    BenchRun run;
+    const auto built = Clock::now();
     const vdbtrace::TracedScene traced = vdbtrace::buildTracedScene(scene);
-    if (buildSeconds) {
-        *buildSeconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    }
+    run.buildSeconds = std::chrono::duration<double>(Clock::now() - built).count();
     tool::Progress shown("vdbtrace: " + label);
-    return vdbtrace::renderMultiscale(traced, {}, withProgress(shown));
+    const double cpu = tool::processCpuSeconds();
+    const auto start = Clock::now();
+    run.result = vdbtrace::renderMethod(method).render(traced, settings, withProgress(shown));
+    run.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    run.cpuSeconds = tool::processCpuSeconds() - cpu;
+    return run;
 }
 
-int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model)
+// The median of `runs` by CPU seconds, with the spread of the CPU seconds.
+struct BenchSummary {
+    BenchRun median;
+    double cpuMin = 0.0, cpuMax = 0.0;
+};
+
+BenchSummary benchRepeated(const scenes::Scene& scene, const std::string& method,
+                           const vdbtrace::MethodSettings& settings, const std::string& label,
+                           int repeats)
 {
+    std::vector<BenchRun> runs;
+    for (int i = 0; i < repeats; ++i) {
+        runs.push_back(benchRun(scene, method, settings,
+                                repeats > 1 ? label + " " + std::to_string(i + 1) : label));
+    }
+    std::sort(runs.begin(), runs.end(),
+              [](const BenchRun& a, const BenchRun& b) { return a.cpuSeconds < b.cpuSeconds; });
+    BenchSummary out;
+    out.cpuMin = runs.front().cpuSeconds;
+    out.cpuMax = runs.back().cpuSeconds;
+    out.median = std::move(runs[runs.size() / 2]);
+    return out;
+}
+
+int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
+          int geometrySamples, int repeats, const fs::path& jsonFile)
+{
+    if (!jsonFile.empty()) io::checkWritable(jsonFile);
+    const double startupCpu = tool::processCpuSeconds();
     scenes::Scene scene = scenes::loadScene(sceneFile);
     model.apply(scene.render.model);
-    double buildSeconds = 0.0;
-    const vdbtrace::RenderResult r = timed(scene, "bench", &buildSeconds);
+    vdbtrace::MethodSettings settings;
+    const BenchSummary ms = benchRepeated(scene, "multiscale", settings, "multiscale", repeats);
+    const vdbtrace::RenderResult& r = ms.median.result;
     const auto& st = r.stats;
     const double pixels = double(st.coneRays);
     const auto share = [&](int level) { return double(st.pixelsPerLevel[level]) / pixels; };
     std::cout << "scene " << sceneFile.string() << " " << scene.camera.width << "x"
               << scene.camera.height << ", threads " << tbb::this_task_arena::max_concurrency()
-              << "\nscene build seconds (trees grown, BVH) " << buildSeconds
-              << "\nrender seconds (with the bough law's profiles, computed on first use) "
-              << r.seconds
-              << "\ncone rays per second " << pixels / r.seconds
-              << "\npeak memory MiB " << tool::peakMemoryMiB() << "\nshare of pixels: none "
-              << share(0) << ", needle " << share(1) << ", cone " << share(2) << ", bough "
-              << share(3) << '\n';
-    if (!scaling) return 0;
-    // Section 7: doubling N or halving dh must leave the cost of bough-level pixels unchanged.
-    const auto perBoughPixel = [](const vdbtrace::RenderResult& x) {
-        return x.stats.pixelsPerLevel[3]
-                   ? double(x.stats.nanosecondsPerLevel[3]) / double(x.stats.pixelsPerLevel[3])
-                   : 0.0;
+              << ", CPU seconds the median of " << repeats << " run(s)"
+              << "\nstart-up CPU seconds (libraries loaded, arguments) " << startupCpu
+              << "\nscene build seconds (trees grown, BVH; not in the times below) "
+              << ms.median.buildSeconds
+              << "\nmultiscale render: CPU seconds " << ms.median.cpuSeconds << " [" << ms.cpuMin
+              << ", " << ms.cpuMax << "], wall seconds " << ms.median.wallSeconds
+              << " (the bough law's profiles included)"
+              << "\ncone rays per second (wall) " << pixels / ms.median.wallSeconds
+              << "\nshare of pixels: none " << share(0) << ", needle " << share(1) << ", cone "
+              << share(2) << ", bough " << share(3) << '\n';
+    nlohmann::json j;
+    j["scene"] = sceneFile.string();
+    j["resolution"] = {scene.camera.width, scene.camera.height};
+    j["threads"] = tbb::this_task_arena::max_concurrency();
+    j["machine"] = machineDescription();
+    j["repeats"] = repeats;
+    j["startup_cpu_seconds"] = startupCpu;
+    j["build_seconds"] = ms.median.buildSeconds;
+    const auto describeRun = [](const BenchSummary& b) {
+        return nlohmann::json{{"cpu_seconds", b.median.cpuSeconds},
+                              {"cpu_seconds_min", b.cpuMin},
+                              {"cpu_seconds_max", b.cpuMax},
+                              {"wall_seconds", b.median.wallSeconds}};
     };
-    scenes::Scene doubled = scene, halved = scene;
-    for (auto& [name, sp] : doubled.species) {
-        sp.needlesAtBase.perCone *= 2;
-        sp.needlesAtTip.perCone *= 2;
+    j["multiscale"] = describeRun(ms);
+    j["multiscale"]["model"] = vdbtrace::renderMethod("multiscale").describe(scene, settings);
+    j["multiscale"]["pixel_share"] = {{"none", share(0)}, {"needle", share(1)},
+                                      {"cone", share(2)}, {"bough", share(3)}};
+    if (geometrySamples > 0) {
+        vdbtrace::MethodSettings g;
+        g.geometry.samples = geometrySamples;
+        const std::string label = "geometry " + std::to_string(geometrySamples) + " spp";
+        const BenchSummary geo = benchRepeated(scene, "geometry", g, label, repeats);
+        const double ratio = ms.median.cpuSeconds / geo.median.cpuSeconds;
+        std::cout << label << " render: CPU seconds " << geo.median.cpuSeconds << " ["
+                  << geo.cpuMin << ", " << geo.cpuMax << "], wall seconds "
+                  << geo.median.wallSeconds << " (its BVH build included)"
+                  << "\nCPU ratio multiscale / geometry " << ratio << '\n';
+        j["geometry"] = describeRun(geo);
+        j["geometry"]["samples_per_pixel"] = geometrySamples;
+        j["cpu_ratio_multiscale_over_geometry"] = ratio;
     }
-    for (auto& [name, sp] : halved.species) {
-        sp.needlesAtBase.coneSpacing_cm /= 2;
-        sp.needlesAtTip.coneSpacing_cm /= 2;
+    if (scaling) {
+        // Section 7: doubling N or halving dh must leave the cost of bough-level pixels
+        // unchanged.
+        const auto perBoughPixel = [](const vdbtrace::RenderResult& x) {
+            return x.stats.pixelsPerLevel[3] ? double(x.stats.nanosecondsPerLevel[3]) /
+                                                   double(x.stats.pixelsPerLevel[3])
+                                             : 0.0;
+        };
+        scenes::Scene doubled = scene, halved = scene;
+        for (auto& [name, sp] : doubled.species) {
+            sp.needlesAtBase.perCone *= 2;
+            sp.needlesAtTip.perCone *= 2;
+        }
+        for (auto& [name, sp] : halved.species) {
+            sp.needlesAtBase.coneSpacing_cm /= 2;
+            sp.needlesAtTip.coneSpacing_cm /= 2;
+        }
+        const BenchRun d = benchRun(doubled, "multiscale", settings, "N x 2");
+        const BenchRun h = benchRun(halved, "multiscale", settings, "dh / 2");
+        std::cout << "bough-level ns per pixel: base " << perBoughPixel(r) << ", N x 2 "
+                  << perBoughPixel(d.result) << ", dh / 2 " << perBoughPixel(h.result) << '\n';
+        j["bough_level_ns_per_pixel"] = {{"base", perBoughPixel(r)},
+                                         {"needles_x2", perBoughPixel(d.result)},
+                                         {"spacing_half", perBoughPixel(h.result)}};
     }
-    const vdbtrace::RenderResult d = timed(doubled, "N x 2");
-    const vdbtrace::RenderResult h = timed(halved, "dh / 2");
-    std::cout << "bough-level ns per pixel: base " << perBoughPixel(r) << ", N x 2 "
-              << perBoughPixel(d) << ", dh / 2 " << perBoughPixel(h) << '\n';
+    const double peak = tool::peakMemoryMiB();
+    std::cout << "peak memory MiB (the process, every run) " << peak << '\n';
+    j["peak_memory_mib"] = peak;
+    if (!jsonFile.empty()) vdbtrace::writeJsonAtomically(j, jsonFile);
     return 0;
 }
 
@@ -578,11 +662,26 @@ int main(int argc, char** argv)
         ->check(CLI::Range(0, 3));
 
     bool scaling = false;
-    auto* benchCmd =
-        app.add_subcommand("bench", "Time a render: seconds, cone rays/s, memory, levels");
+    auto* benchCmd = app.add_subcommand(
+        "bench", "Time multiscale against geometry in one run: CPU and wall seconds, their "
+                 "ratio, cone rays/s, memory, levels");
     benchCmd->add_option("scene", sceneFile, "Scene file (JSON)")->required();
     benchCmd->add_flag("--scaling", scaling,
                        "Also render with N x 2 and dh / 2 (section 7's scaling claim)");
+    int benchGeometrySamples = 4, benchRepeats = 1;
+    fs::path benchJson;
+    benchCmd
+        ->add_option("--geometry-samples", benchGeometrySamples,
+                     "Samples per pixel of the geometry render timed beside it (0: none)")
+        ->check(CLI::Range(0, 4096))
+        ->capture_default_str();
+    benchCmd
+        ->add_option("--repeat", benchRepeats,
+                     "Runs of each render; the times are the median by CPU seconds, with the "
+                     "least and the most")
+        ->check(CLI::Range(1, 15))
+        ->capture_default_str();
+    benchCmd->add_option("--json", benchJson, "Also write every number as JSON");
     model.add(*benchCmd);
 
     fs::path diffA, diffB, diffOut;
@@ -656,6 +755,6 @@ int main(int argc, char** argv)
             vdbtrace::runCompare(compare);
             return 0;
         }
-        return bench(sceneFile, scaling, model);
+        return bench(sceneFile, scaling, model, benchGeometrySamples, benchRepeats, benchJson);
     });
 }

@@ -28,5 +28,7 @@ CLI::Validator positiveNumber();
 
 /// The process's peak resident memory so far, in MiB (for the tools' summary lines).
 double peakMemoryMiB();
+/// CPU seconds the process has used so far, all threads (user and system).
+double processCpuSeconds();
 
 }  // namespace pine::tool
