@@ -74,6 +74,7 @@ struct BoughShading {
 class BoughLaw {
 public:
     virtual ~BoughLaw() = default;
+    /// Its conventions, known without shading a bough (the paper's laws keep the defaults).
     virtual BoughLawTraits traits() const { return {}; }
     /// Bough b (its frame, geometry, R and A set), seen along unit V (towards the camera),
     /// its strip's offsets measured along b.across, and lit along each unit direction of
