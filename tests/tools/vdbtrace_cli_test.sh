@@ -215,10 +215,20 @@ assert math.isclose(j["cpu_ratio_multiscale_over_geometry"], ratio, rel_tol=1e-1
 assert j["multiscale"]["model"]["bough_law"] == "exact", j["multiscale"]["model"]
 assert abs(sum(j["multiscale"]["pixel_share"].values()) - 1) < 1e-9
 assert j["resolution"] == [48, 36] and j["startup_cpu_seconds"] > 0
-assert "CPU ratio multiscale / geometry" in out and "geometry 2 spp render" in out, out
+# The printed lines say the JSON's numbers (6 significant digits).
+printed = dict(line.rsplit(" ", 1) for line in out.splitlines() if line.startswith("CPU ratio"))
+assert math.isclose(float(printed["CPU ratio multiscale / geometry"]), ratio, rel_tol=1e-5), out
+assert ("multiscale render: CPU seconds %g [%g, %g]" % (j["multiscale"]["cpu_seconds"],
+        j["multiscale"]["cpu_seconds_min"], j["multiscale"]["cpu_seconds_max"])) in out, out
+assert "geometry 2 spp render: CPU seconds %g" % j["geometry"]["cpu_seconds"] in out, out
 PY
 expect_error "bench JSON into a missing folder" 2 "no/such" -- \
     bench "$work/small-firs.json" --json "$work/no/such/b.json"
+cp "$work/small-firs.json" "$work/kept.json"
+expect_error "bench JSON over its scene" 2 "also an input" -- \
+    bench "$work/small-firs.json" --json "$work/small-firs.json"
+cmp -s "$work/kept.json" "$work/small-firs.json" || fail "bench --json overwrote its scene"
+expect_error "bench even repeats" 2 "odd number" -- bench "$work/small-firs.json" --repeat 2
 
 "$vdbtrace" --help >/dev/null || fail "--help"
 "$vdbtrace" render --help >/dev/null || fail "render --help"

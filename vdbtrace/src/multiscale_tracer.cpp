@@ -446,11 +446,14 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
                   return x.nearest < y.nearest || (x.nearest == y.nearest && x.index < y.index);
               });
     mFragments.clear();
-    std::size_t done = 0;  // of mFragments, composited
+    std::size_t done = 0, sorted = 0;  // of mFragments: composited, and sorted by depth
     // Composites the fragments made so far that lie before `depth`: none made later can.
     const auto compositeBefore = [&](double depth) {
-        std::stable_sort(mFragments.begin() + done, mFragments.end(),
-                         [](const Fragment& a, const Fragment& b) { return a.t < b.t; });
+        if (sorted != mFragments.size()) {
+            std::stable_sort(mFragments.begin() + done, mFragments.end(),
+                             [](const Fragment& a, const Fragment& b) { return a.t < b.t; });
+            sorted = mFragments.size();
+        }
         while (done < mFragments.size() && mFragments[done].t <= depth &&
                !composite.opaque()) {
             composite.add(mFragments[done++]);

@@ -94,9 +94,20 @@ struct BoughLawEvaluation {
     std::vector<StripProfile> fromLight;
 };
 
+namespace {
+
+// A bough not made by makeTracedBough has no law to ask.
+BoughLawEvaluation& evaluation(const std::shared_ptr<BoughLawEvaluation>& law)
+{
+    if (!law) throw std::logic_error("a bough made without makeTracedBough has no law");
+    return *law;
+}
+
+}  // namespace
+
 const BoughView& TracedBough::view() const
 {
-    BoughLawEvaluation& e = *law;
+    BoughLawEvaluation& e = evaluation(law);
     std::call_once(e.viewOnce, [&] {
         const BoughShading shading = e.law->shade(*this, e.V, e.towards, *e.layers, e.needs);
         if (shading.lights.size() != e.towards.size()) {
@@ -125,7 +136,7 @@ const BoughView& TracedBough::view() const
 
 const StripProfile& TracedBough::opacityFromLight(std::size_t light) const
 {
-    BoughLawEvaluation& e = *law;
+    BoughLawEvaluation& e = evaluation(law);
     std::call_once(e.fromLightOnce[light], [&] {
         e.fromLight[light] = e.law->opacityFromLight(*this, e.towards[light], *e.layers);
     });
@@ -175,6 +186,15 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
     b.across = stripAcross(b.axis, e->V);
     b.law = std::move(e);
     return b;
+}
+
+void computeLawProfiles(const TracedScene& scene)
+{
+    tbb::parallel_for(std::size_t(0), scene.boughs.size(), [&](std::size_t k) {
+        const TracedBough& b = scene.boughs[k];
+        b.view();
+        for (std::size_t i = 0; i < scene.lights.size(); ++i) b.opacityFromLight(i);
+    });
 }
 
 std::vector<std::string> shadowOriginNames() { return {"needles", "axis"}; }

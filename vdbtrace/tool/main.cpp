@@ -416,7 +416,10 @@ BenchSummary benchRepeated(const scenes::Scene& scene, const std::string& method
 int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
           int geometrySamples, int repeats, const fs::path& jsonFile)
 {
-    if (!jsonFile.empty()) io::checkWritable(jsonFile);
+    if (!jsonFile.empty()) {
+        io::checkWritable(jsonFile);
+        io::checkOutputsApart({jsonFile}, {sceneFile});
+    }
     const double startupCpu = tool::processCpuSeconds();
     scenes::Scene scene = scenes::loadScene(sceneFile);
     model.apply(scene.render.model);
@@ -472,7 +475,8 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
     }
     if (scaling) {
         // Section 7: doubling N or halving dh must leave the cost of bough-level pixels
-        // unchanged.
+        // unchanged. A bough's law profiles are computed by whichever pixel (of any level)
+        // first needs them, so here they are all computed before each render and timed apart.
         const auto perBoughPixel = [](const vdbtrace::RenderResult& x) {
             return x.stats.pixelsPerLevel[3] ? double(x.stats.nanosecondsPerLevel[3]) /
                                                    double(x.stats.pixelsPerLevel[3])
@@ -487,13 +491,28 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
             sp.needlesAtBase.coneSpacing_cm /= 2;
             sp.needlesAtTip.coneSpacing_cm /= 2;
         }
-        const BenchRun d = benchRun(doubled, "multiscale", settings, "N x 2");
-        const BenchRun h = benchRun(halved, "multiscale", settings, "dh / 2");
-        std::cout << "bough-level ns per pixel: base " << perBoughPixel(r) << ", N x 2 "
-                  << perBoughPixel(d.result) << ", dh / 2 " << perBoughPixel(h.result) << '\n';
-        j["bough_level_ns_per_pixel"] = {{"base", perBoughPixel(r)},
-                                         {"needles_x2", perBoughPixel(d.result)},
-                                         {"spacing_half", perBoughPixel(h.result)}};
+        const auto scaled = [&](const scenes::Scene& s, const std::string& label,
+                                double& lawCpuSeconds) {
+            const vdbtrace::TracedScene traced = vdbtrace::buildTracedScene(s);
+            const double cpu = tool::processCpuSeconds();
+            vdbtrace::computeLawProfiles(traced);
+            lawCpuSeconds = tool::processCpuSeconds() - cpu;
+            tool::Progress shown("vdbtrace: " + label);
+            return perBoughPixel(
+                vdbtrace::renderMultiscale(traced, settings.multiscale, withProgress(shown)));
+        };
+        double lawBase, lawDoubled, lawHalved;
+        const double base = scaled(scene, "as is", lawBase);
+        const double d = scaled(doubled, "N x 2", lawDoubled);
+        const double h = scaled(halved, "dh / 2", lawHalved);
+        std::cout << "bough-level ns per pixel (the law's profiles computed before): as is "
+                  << base << ", N x 2 " << d << ", dh / 2 " << h
+                  << "\nthe law's profiles of every bough, CPU seconds: as is " << lawBase
+                  << ", N x 2 " << lawDoubled << ", dh / 2 " << lawHalved << '\n';
+        j["bough_level_ns_per_pixel"] = {
+            {"base", base}, {"needles_x2", d}, {"spacing_half", h}};
+        j["law_profiles_cpu_seconds"] = {
+            {"base", lawBase}, {"needles_x2", lawDoubled}, {"spacing_half", lawHalved}};
     }
     const double peak = tool::peakMemoryMiB();
     std::cout << "peak memory MiB (the process, every run) " << peak << '\n';
@@ -677,9 +696,19 @@ int main(int argc, char** argv)
         ->capture_default_str();
     benchCmd
         ->add_option("--repeat", benchRepeats,
-                     "Runs of each render; the times are the median by CPU seconds, with the "
-                     "least and the most")
-        ->check(CLI::Range(1, 15))
+                     "Runs of each render (odd); the times are the median by CPU seconds, "
+                     "with the least and the most")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                try {
+                    const int k = std::stoi(text);
+                    if (k >= 1 && k <= 15 && k % 2 == 1) return {};
+                } catch (const std::exception&) {
+                }
+                return "must be an odd number from 1 to 15 (the median is one run), got '" +
+                       text + "'";
+            },
+            "odd in [1, 15]"))
         ->capture_default_str();
     benchCmd->add_option("--json", benchJson, "Also write every number as JSON");
     model.add(*benchCmd);

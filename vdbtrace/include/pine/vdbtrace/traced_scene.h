@@ -133,6 +133,10 @@ struct TracedScene {
     }
 };
 
+/// Computes every bough's law profiles now (view() and each light's opacityFromLight()), in
+/// parallel, as a render would on first use: for timing a render without them.
+void computeLawProfiles(const TracedScene& scene);
+
 /// The values of render.shadow_origin, the faithful one first.
 std::vector<std::string> shadowOriginNames();
 
