@@ -267,7 +267,9 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
         boxes.push_back(cylinderBounds(b.base_cm, b.tip_cm, b.radius_cm));
     }
     for (const TracedBough& b : out.boughs) {
-        boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm));
+        // Needles reach R from the axis and are r thick.
+        boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm,
+                                       b.radius_cm + b.geometry.cone.needleRadius_cm));
     }
     out.bvh = Bvh(boxes);
     return out;
