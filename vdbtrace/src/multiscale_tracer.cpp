@@ -463,8 +463,7 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
         compositeBefore(c.nearest);
         if (composite.opaque()) return;
         if (c.index == kGround) {
-            Fragment ground;
-            if (mSurfaces.ground(ray, ground)) mFragments.push_back(ground);
+            mFragments.push_back(mSurfaces.groundAt(ray, tGround, normal));
         } else if (!mScene.isBranch(c.index)) {
             addBough(ray, c.index);
         } else {

@@ -117,16 +117,23 @@ bool SurfaceShading::ground(const ConeRay& ray, Fragment& out)
     double t;
     Vec3 normal;
     if (!hitGround(mScene.scene->ground, ray, t, normal)) return false;
+    out = groundAt(ray, t, normal);
+    return true;
+}
+
+Fragment SurfaceShading::groundAt(const ConeRay& ray, double t, const Vec3& normal)
+{
     ++mStats.groundHits;
+    Fragment out;
     out = Fragment{t, 1.0, Vec3(0.0), Vec3(0.0), 0, false};
-    if (!mPlan.diffuse) return true;
+    if (!mPlan.diffuse) return out;
     for (const Incident& light : lightAt(ray.origin + t * ray.direction, ray.width(t),
                                          kNoPrimitive)) {
         out.diffuse += mScene.scene->ground.albedo / analytic::kPi * light.irradiance *
                        std::max(0.0, glm::dot(normal, light.towards));
         ++mStats.diffuseEvaluations;
     }
-    return true;
+    return out;
 }
 
 }  // namespace pine::vdbtrace

@@ -80,6 +80,8 @@ public:
     bool branch(const ConeRay& ray, std::size_t index, double tMax, Fragment& out);
     /// The ground, when the ray's axis meets it: false otherwise. `out.t` is the distance.
     bool ground(const ConeRay& ray, Fragment& out);
+    /// The ground where hitGround found the ray's axis meets it, at t with `normal`.
+    Fragment groundAt(const ConeRay& ray, double t, const Vec3& normal);
 
 private:
     const TracedScene& mScene;
