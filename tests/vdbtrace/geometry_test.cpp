@@ -9,11 +9,36 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <set>
 
 namespace pine::vdbtrace {
 namespace {
+
+// The brute force the BVH is checked against: a ray-box slab test with the box grown by
+// `margin` on every side, dividing by the direction (the BVH multiplies by its reciprocal).
+bool intersectBox(const ConeRay& ray, const Aabb& box, double margin, double tMax, double& tIn,
+                  double& tOut)
+{
+    double t0 = 0.0, t1 = tMax;
+    for (int i = 0; i < 3; ++i) {
+        const double lo = box.lo[i] - margin, hi = box.hi[i] + margin;
+        const double d = ray.direction[i], o = ray.origin[i];
+        if (std::abs(d) < 1e-300) {
+            if (o < lo || o > hi) return false;
+            continue;
+        }
+        double a = (lo - o) / d, b = (hi - o) / d;
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+        if (t0 > t1) return false;
+    }
+    tIn = t0;
+    tOut = t1;
+    return true;
+}
 
 TEST(Geometry, CylinderIntervalMatchesTheChord)
 {

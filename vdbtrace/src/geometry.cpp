@@ -16,28 +16,6 @@ Aabb cylinderBounds(const Vec3& a, const Vec3& b, double radius)
     return box;
 }
 
-bool intersectBox(const ConeRay& ray, const Aabb& box, double margin, double tMax, double& tIn,
-                  double& tOut)
-{
-    double t0 = 0.0, t1 = tMax;
-    for (int i = 0; i < 3; ++i) {
-        const double lo = box.lo[i] - margin, hi = box.hi[i] + margin;
-        const double d = ray.direction[i], o = ray.origin[i];
-        if (std::abs(d) < 1e-300) {
-            if (o < lo || o > hi) return false;
-            continue;
-        }
-        double a = (lo - o) / d, b = (hi - o) / d;
-        if (a > b) std::swap(a, b);
-        t0 = std::max(t0, a);
-        t1 = std::min(t1, b);
-        if (t0 > t1) return false;
-    }
-    tIn = t0;
-    tOut = t1;
-    return true;
-}
-
 bool closestPassage(const ConeRay& ray, const Vec3& a, const Vec3& b, Passage& out)
 {
     const Vec3 axis = b - a;

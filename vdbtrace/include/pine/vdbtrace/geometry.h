@@ -32,11 +32,6 @@ struct Aabb {
 /// Box of a cylinder (segment a-b, radius r), conservatively.
 Aabb cylinderBounds(const Vec3& a, const Vec3& b, double radius);
 
-/// Ray-box slab test with the box grown by `margin` on every side: the entry and exit distance
-/// clipped to [0, tMax], or false.
-bool intersectBox(const ConeRay& ray, const Aabb& box, double margin, double tMax, double& tIn,
-                  double& tOut);
-
 /// Where a cone ray passes a finite thin cylinder (segment a-b, radius r): closest approach of
 /// the ray's axis to the cylinder's, its distance `t` along the ray, the distance `gap` between
 /// the two axes, and where on the segment (`s` in [0, 1]). False when the closest point lies
