@@ -164,7 +164,7 @@ scene = json.load(open(sys.argv[1]))
 scene.setdefault("render", {})["bough_law"] = "quadratic"
 json.dump(scene, open(sys.argv[2], "w"))
 PY
-expect_error "unknown bough law" 2 "law.json: render.bough_law: unknown bough law 'quadratic' (known: exact, linear)" \
+expect_error "unknown bough law" 2 "law.json: render.bough_law: unknown bough law 'quadratic' (known: exact, linear, corrected)" \
     -- render "$work/law.json" --out "$work/q.exr"
 [ ! -e "$work/q.exr" ] || fail "a refused scene wrote an image"
 

@@ -231,7 +231,7 @@ void expectInputError(F&& f, const std::string& text)
 
 TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
 {
-    expectInputError([] { boughLaw("quadratic"); }, "exact, linear");
+    expectInputError([] { boughLaw("quadratic"); }, "exact, linear, corrected");
     // The first registered is the scene's default.
     EXPECT_EQ(boughLawNames().front(), scenes::ModelChoices{}.boughLaw);
     EXPECT_EQ(layerModelNames().front(), scenes::ModelChoices{}.layerModel);

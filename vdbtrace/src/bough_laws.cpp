@@ -6,7 +6,7 @@
 
 namespace pine::vdbtrace {
 
-std::unique_ptr<BoughLaw> makeExactBoughLaw();
+std::unique_ptr<BoughLaw> makeCorrectedBoughLaw();
 std::unique_ptr<BoughLaw> makeLinearBoughLaw();
 
 namespace {
@@ -17,6 +17,7 @@ const Registry<BoughLaw>& registry()
         Registry<BoughLaw> r("bough law");
         r.add("exact", makeExactBoughLaw());    // the layers crossed, chord by chord (faithful)
         r.add("linear", makeLinearBoughLaw());  // section 6.6, clamped (the paper's)
+        r.add("corrected", makeCorrectedBoughLaw());  // the exact law, tabulated
         return r;
     }();
     return laws;

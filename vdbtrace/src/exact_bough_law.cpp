@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace pine::vdbtrace {
 namespace {
@@ -93,6 +94,13 @@ bool chord(const TracedBough& b, const Vec3& d, const Vec3& across, int k, int p
 
 class ExactBoughLaw final : public BoughLaw {
 public:
+    explicit ExactBoughLaw(int density)
+        : mShadingChords{kShadingChords.count * density, kShadingChords.atEachEnd * density},
+          mOpacityChords{kOpacityChords.count * density, kOpacityChords.atEachEnd * density}
+    {
+        if (density < 1) throw std::invalid_argument("the exact law needs a chord density >= 1");
+    }
+
     BoughLawTraits traits() const override
     {
         return {RearComposite::Share, /*stripToConesEnd=*/true, /*shadesNeedles=*/true};
@@ -117,10 +125,10 @@ public:
         for (int k = 0; k < kCells; ++k) {
             // Opacities are even in the offset: with no light to shade, half the cells do.
             if (lights == 0 && k >= kCells / 2) continue;
-            for (int p = 0; p < kShadingChords.count; ++p) {
+            for (int p = 0; p < mShadingChords.count; ++p) {
                 Vec3 o;
                 double tIn, tOut, weight;
-                if (!chord(b, d, b.across, k, p, kShadingChords, o, tIn, tOut, weight)) continue;
+                if (!chord(b, d, b.across, k, p, mShadingChords, o, tIn, tOut, weight)) continue;
                 const double tMid = 0.5 * (tIn + tOut);
                 double T = 1.0;
                 layers.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
@@ -195,10 +203,10 @@ public:
                 cells[k] = cells[kCells - 1 - k];
                 continue;
             }
-            for (int p = 0; p < kOpacityChords.count; ++p) {
+            for (int p = 0; p < mOpacityChords.count; ++p) {
                 Vec3 o;
                 double tIn, tOut, weight;
-                if (!chord(b, d, across, k, p, kOpacityChords, o, tIn, tOut, weight)) continue;
+                if (!chord(b, d, across, k, p, mOpacityChords, o, tIn, tOut, weight)) continue;
                 double T = 1.0;
                 layers.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
                     T *= 1.0 - hit.opacity;
@@ -209,10 +217,16 @@ public:
         }
         return StripProfile::sampled(cells);
     }
+
+private:
+    Chords mShadingChords, mOpacityChords;
 };
 
 }  // namespace
 
-std::unique_ptr<BoughLaw> makeExactBoughLaw() { return std::make_unique<ExactBoughLaw>(); }
+std::unique_ptr<BoughLaw> makeExactBoughLaw(int density)
+{
+    return std::make_unique<ExactBoughLaw>(density);
+}
 
 }  // namespace pine::vdbtrace

@@ -24,6 +24,16 @@ StripProfile StripProfile::sampled(const std::vector<double>& cells)
     return p;
 }
 
+std::vector<double> StripProfile::cellValues() const
+{
+    std::vector<double> cells;
+    const double width = mPrefix.empty() ? 0.0 : 2.0 / double(mPrefix.size() - 1);
+    for (std::size_t k = 1; k < mPrefix.size(); ++k) {
+        cells.push_back((mPrefix[k] - mPrefix[k - 1]) / width);
+    }
+    return cells;
+}
+
 double StripProfile::mean() const { return isConstant() ? mConstant : 0.5 * mPrefix.back(); }
 
 double StripProfile::integralTo(double u) const

@@ -209,9 +209,8 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
             throw InputError(scene.source.string() + ": render." + key + ": " + e.what());
         }
     };
-    const BoughLaw& law = chosen("bough_law", [&]() -> const BoughLaw& {
-        return boughLaw(model.boughLaw);
-    });
+    const std::shared_ptr<const BoughLaw> law =
+        chosen("bough_law", [&] { return boughLaw(model.boughLaw).fresh(); });
     const LayerModel& layers = chosen("layer_model", [&]() -> const LayerModel& {
         return layerModel(model.layerModel);
     });
@@ -227,6 +226,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
     TracedScene out;
     out.scene = &scene;
     out.layers = &layers;
+    out.boughLaw = law;
     out.shadowsFromNeedles = fromNeedles;
     out.lights = unifiedLights(scene);
     out.trees.resize(scene.trees.size());
@@ -257,7 +257,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
     }
     out.boughs.resize(boughs.size());
     tbb::parallel_for(std::size_t(0), boughs.size(), [&](std::size_t k) {
-        out.boughs[k] = makeTracedBough(boughs[k], scene.camera.position_cm, out.lights, law,
+        out.boughs[k] = makeTracedBough(boughs[k], scene.camera.position_cm, out.lights, *law,
                                        layers, needs);
     });
 

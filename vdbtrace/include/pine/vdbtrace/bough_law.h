@@ -76,6 +76,13 @@ public:
     virtual ~BoughLaw() = default;
     /// Its conventions, known without shading a bough (the paper's laws keep the defaults).
     virtual BoughLawTraits traits() const { return {}; }
+    /// The law one scene renders with: this one (not owned) for a law without state; a law
+    /// that fills tables as it goes makes a new one, so that every scene fills its own (compare
+    /// and bench time each render from nothing).
+    virtual std::shared_ptr<const BoughLaw> fresh() const
+    {
+        return std::shared_ptr<const BoughLaw>(std::shared_ptr<const BoughLaw>(), this);
+    }
     /// Bough b (its frame, geometry, R and A set), seen along unit V (towards the camera),
     /// its strip's offsets measured along b.across, and lit along each unit direction of
     /// `towardsLights`. `layers` is the render's layer model, for a law that crosses the
@@ -90,6 +97,11 @@ public:
     virtual StripProfile opacityFromLight(const TracedBough& b, const Vec3& towardsLight,
                                           const LayerModel& layers) const = 0;
 };
+
+/// The exact law (registered as "exact" with density 1) with `density` times its chords per
+/// cell: the converged law the corrected law tabulates and tests compare with. @throw
+/// std::invalid_argument for a density below 1.
+std::unique_ptr<BoughLaw> makeExactBoughLaw(int density = 1);
 
 /// The law registered as `name`; throws InputError naming the registered ones.
 const BoughLaw& boughLaw(const std::string& name);

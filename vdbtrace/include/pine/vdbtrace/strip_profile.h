@@ -21,6 +21,8 @@ public:
     static StripProfile sampled(const std::vector<double>& cells);
 
     bool isConstant() const { return mPrefix.empty(); }
+    /// A sampled profile's cells, as given to sampled(); none for a constant.
+    std::vector<double> cellValues() const;
     /// The mean over the strip.
     double mean() const;
     /// (1 / w) times the integral of the value over the footprint [gap - w/2, gap + w/2]

@@ -122,6 +122,9 @@ struct TracedScene {
     std::vector<TracedBough> boughs;     ///< primitive index branches.size() + j
     Bvh bvh;
     const LayerModel* layers = nullptr;  ///< how a layer stops a line (layer_model.h)
+    /// The bough law the boughs were made with: this scene's own (BoughLaw::fresh), which the
+    /// boughs point to.
+    std::shared_ptr<const BoughLaw> boughLaw;
     /// render.shadow_origin "needles": a bough hit's shadow cone stands for where the needles
     /// it shows lie (ShadowSamples); "axis": one line from the chord's middle.
     bool shadowsFromNeedles = true;
