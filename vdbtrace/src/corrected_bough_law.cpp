@@ -21,12 +21,15 @@
 // Tables per scene and geometry, filled lazily node by node: a forest whose boughs share one
 // geometry evaluates the exact law at the nodes its boughs' directions touch (a surface in
 // the three angles, for one light and a far camera), not once per bough. Three tables: the
-// view's opacity (theta_v, L), the opacity from a light (theta_l, L) and each light's
-// transfer and reflectances (theta_v, theta_l, |Delta|, L). How far this is from the exact
+// view's opacity (theta_v, L) split by the needles' azimuth, the opacity from a light
+// (theta_l, L) and, with self-shadowing only, each light's transfer and reflectances
+// (theta_v, theta_l, |Delta|, L). How far this is from the exact
 // law over the parameter space is measured by CorrectedBoughLaw.AgreesWithTheExactLaw; on the
 // paper forest it computes 7,474 light nodes for 26,400 boughs (docs/models.md).
-#include "pine/vdbtrace/bough_law.h"
+#include "exact_bough_law.h"
 
+#include "pine/analytic/needle_shader.h"
+#include "pine/vdbtrace/bough_law.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -63,6 +66,10 @@ constexpr int kWithinKnots = 2;
 // bough's view and light opacities, 6 and 10 chords a cell, differ by that much), so that the
 // table is nearer the converged law than the exact law is.
 constexpr int kChordDensity = 2;
+// Bins of the needles' azimuth about the axis in the view's table (7.5 degrees): without
+// self-shadowing a light's reflectances are the bins' shares times eqs. 1-2 at each bin's
+// needle, so the light's two angles need no table.
+constexpr int kAzimuthBins = 48;
 
 // A coordinate's place among knots: the knot below and the fraction to the next (beyond the
 // last two for a count past the last knot).
@@ -162,17 +169,17 @@ Kind kindOf(const TracedBough& b, const LayerModel& layers)
 // The exact law tabulated for one kind of bough.
 class Tables {
 public:
-    static constexpr int kCells = 12;  // the exact law's
+    static constexpr int kCells = kExactLawCells;
 
     Tables(const BoughLaw& exact, const TracedBough& like, const LayerModel& layers)
         : mExact(exact), mGeometry(like.geometry), mExponent(like.exponent), mLayers(layers),
           mReach(like.geometry.cone.needleLength_cm * std::cos(like.geometry.cone.aperture_rad)),
-          mView({kViewKnots, kCountKnots, kWithinKnots}, 2 * kCells,
+          mView({kViewKnots, kCountKnots, kWithinKnots}, 2 * kCells * kAzimuthBins,
                 [this](const auto& i) {
                     const Vec3 V = view(i[0]);
                     const TracedBough b = bough(i[1], i[2], V);
-                    const BoughShading s = mExact.shade(b, V, {}, mLayers, {});
-                    return integrated(b, {cellsOf(s.alpha.front), cellsOf(s.alpha.rear)});
+                    return integrated(
+                        b, {exactSeenByAzimuth(b, V, mLayers, kChordDensity, kAzimuthBins)});
                 }),
           mFromLight({kLightKnots, kCountKnots, kWithinKnots}, kCells, [this](const auto& i) {
               const Vec3 L = light(i[0], 0);
@@ -197,7 +204,8 @@ public:
                 1.0 / (length_cm + mReach)};
     }
 
-    std::vector<double> viewAlpha(double thetaV, const Length& l) const
+    /// What each half shows: [half][cell][azimuth bin].
+    std::vector<double> viewSeen(double thetaV, const Length& l) const
     {
         return mView.at({place(thetaV, kPi, kViewKnots), l.count, l.within}, l.perStrip);
     }
@@ -327,14 +335,20 @@ public:
         const Tables& t = tables(b, layers);
         const Tables::Length length = t.length(b.length_cm);
         const double thetaV = angleTo(b.axis, V);
-        std::vector<double> alpha = t.viewAlpha(thetaV, length);
+        const std::vector<double> seen = t.viewSeen(thetaV, length);
+        std::vector<double> alpha(2 * kCells, 0.0);
+        for (std::size_t i = 0; i < seen.size(); ++i) alpha[i / kAzimuthBins] += seen[i];
         std::vector<std::vector<double>> lights;
         const Vec3 ev = glm::cross(b.across, b.axis);
         for (const Vec3& L : towardsLights) {
-            const double azimuth = std::atan2(glm::dot(L, b.across), glm::dot(L, ev));
-            lights.push_back(
-                t.lightValues(thetaV, angleTo(b.axis, L), std::abs(azimuth), length, needs));
-            if (azimuth < 0.0) lights.back() = reversedCells(lights.back());
+            if (needs.transfer) {
+                const double azimuth = std::atan2(glm::dot(L, b.across), glm::dot(L, ev));
+                lights.push_back(t.lightValues(thetaV, angleTo(b.axis, L), std::abs(azimuth),
+                                               length, needs));
+                if (azimuth < 0.0) lights.back() = reversedCells(lights.back());
+            } else {
+                lights.push_back(unshadowed(b, V, L, seen, alpha, ev, needs));
+            }
         }
         // As the exact law: a cell whose halves add up past 1 (oblique chords past the strip's
         // ends) is scaled back to a coverage.
@@ -365,6 +379,36 @@ public:
     }
 
 private:
+    // Without self-shadowing: the transfer is the opacity, and each half reflects its bins'
+    // shares times eqs. 1-2 at each bin's needle direction, in the layout of
+    // Tables::lightValues.
+    static std::vector<double> unshadowed(const TracedBough& b, const Vec3& V, const Vec3& L,
+                                          const std::vector<double>& seen,
+                                          const std::vector<double>& alpha, const Vec3& ev,
+                                          const BoughLawNeeds& needs)
+    {
+        const double phi = b.geometry.cone.aperture_rad;
+        std::array<double, kAzimuthBins> diffuse{}, specular{};
+        for (int i = 0; i < kAzimuthBins; ++i) {
+            const double psi = -kPi + (i + 0.5) * 2.0 * kPi / kAzimuthBins;
+            const Vec3 needle =
+                std::cos(phi) * b.axis +
+                std::sin(phi) * (std::cos(psi) * ev + std::sin(psi) * b.across);
+            if (needs.diffuse) diffuse[i] = analytic::needleDiffuse(needle, L, V);
+            if (needs.specular) specular[i] = analytic::needleSpecular(needle, L, V, b.exponent);
+        }
+        std::vector<double> v(6 * kCells, 0.0);
+        for (int hk = 0; hk < 2 * kCells; ++hk) {
+            v[hk] = alpha[hk];
+            for (int i = 0; i < kAzimuthBins; ++i) {
+                const double share = seen[std::size_t(hk) * kAzimuthBins + i];
+                v[2 * kCells + hk] += share * diffuse[i];
+                v[4 * kCells + hk] += share * specular[i];
+            }
+        }
+        return v;
+    }
+
     const Tables& tables(const TracedBough& b, const LayerModel& layers) const
     {
         std::lock_guard<std::mutex> lock(mMutex);

@@ -11,6 +11,8 @@
 // drawn on runs from the base to the cones' end, and a cell's value is the integral over the
 // chords' passages along the axis over that length, so that the strip covers what the needles
 // cover; what oblique chords meet beyond its ends is put onto it, each cell kept a coverage.
+#include "exact_bough_law.h"
+
 #include "pine/vdbtrace/bough_law.h"
 
 #include "pine/analytic/needle_shader.h"
@@ -31,7 +33,7 @@ namespace {
 // averages over where the cones fall. A chord's opacity is even in its offset (the mirror
 // through the plane of the axis and the chord maps cones onto cones), so opacities are
 // computed on half the cells; transfers are not even (the light is on one side).
-constexpr int kCells = 12;
+constexpr int kCells = kExactLawCells;
 // A chord's layers, each lit through the bough: the shading's chords cost a walk towards each
 // light per layer and are fewer; the opacity from a light, whose deep shadows show its every
 // cell, takes more.
@@ -110,7 +112,6 @@ public:
                        const BoughLawNeeds& needs) const override
     {
         BoughShading out;
-        const Vec3 d = -V;
         const double phi = b.geometry.cone.aperture_rad;
         const double cotPhi = 1.0 / std::tan(phi), sinPhi = std::sin(phi), cosPhi = std::cos(phi);
         const std::size_t lights = towardsLights.size();
@@ -122,44 +123,30 @@ public:
         for (int h = 0; h < 2; ++h) {
             lit[h] = diffuse[h] = specular[h] = std::vector<Cells>(lights, Cells(kCells, 0.0));
         }
-        for (int k = 0; k < kCells; ++k) {
-            // Opacities are even in the offset: with no light to shade, half the cells do.
-            if (lights == 0 && k >= kCells / 2) continue;
-            for (int p = 0; p < mShadingChords.count; ++p) {
-                Vec3 o;
-                double tIn, tOut, weight;
-                if (!chord(b, d, b.across, k, p, mShadingChords, o, tIn, tOut, weight)) continue;
-                const double tMid = 0.5 * (tIn + tOut);
-                double T = 1.0;
-                layers.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
-                    if (T < kOpaque) return;
-                    const double share = T * hit.opacity;  // what this layer shows
-                    T *= 1.0 - hit.opacity;
-                    const int half = hit.t < tMid ? 0 : 1;
-                    alpha[half][k] += share * weight;
-                    if (share <= 0.0) return;
-                    const Vec3 x = o + hit.t * d;
-                    double rho;
-                    Vec3 radial;
-                    coneHeight(b, cotPhi, x, &rho, &radial);
-                    const Vec3 needle = cosPhi * b.axis + sinPhi * radial;  // as at level 2
-                    for (std::size_t i = 0; i < lights; ++i) {
-                        const Vec3& L = towardsLights[i];
-                        const double seen =
-                            share * weight *
-                            (needs.transfer ? layers.transmittance(b, x, L, hit.cone) : 1.0);
-                        lit[half][i][k] += seen;
-                        if (needs.diffuse) {
-                            diffuse[half][i][k] += seen * analytic::needleDiffuse(needle, L, V);
-                        }
-                        if (needs.specular) {
-                            specular[half][i][k] +=
-                                seen * analytic::needleSpecular(needle, L, V, b.exponent);
-                        }
-                    }
-                });
+        // Opacities are even in the offset: with no light to shade, half the cells do.
+        forEachShownLayer(b, V, layers, lights > 0, [&](const ShownLayer& shown) {
+            alpha[shown.half][shown.cell] += shown.share;
+            if (shown.share <= 0.0) return;
+            double rho;
+            Vec3 radial;
+            coneHeight(b, cotPhi, shown.x, &rho, &radial);
+            const Vec3 needle = cosPhi * b.axis + sinPhi * radial;  // as at level 2
+            for (std::size_t i = 0; i < lights; ++i) {
+                const Vec3& L = towardsLights[i];
+                const double seen =
+                    shown.share *
+                    (needs.transfer ? layers.transmittance(b, shown.x, L, shown.cone) : 1.0);
+                lit[shown.half][i][shown.cell] += seen;
+                if (needs.diffuse) {
+                    diffuse[shown.half][i][shown.cell] +=
+                        seen * analytic::needleDiffuse(needle, L, V);
+                }
+                if (needs.specular) {
+                    specular[shown.half][i][shown.cell] +=
+                        seen * analytic::needleSpecular(needle, L, V, b.exponent);
+                }
             }
-        }
+        });
         for (int k = kCells / 2; k < kCells && lights == 0; ++k) {
             alpha[0][k] = alpha[0][kCells - 1 - k];
             alpha[1][k] = alpha[1][kCells - 1 - k];
@@ -218,7 +205,70 @@ public:
         return StripProfile::sampled(cells);
     }
 
+    std::vector<double> seenByAzimuth(const TracedBough& b, const Vec3& V,
+                                      const LayerModel& layers, int bins) const
+    {
+        const double cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad);
+        const Vec3 ev = glm::cross(b.across, b.axis);
+        std::vector<double> seen(2 * kCells * std::size_t(bins), 0.0);
+        const auto at = [&](int half, int cell, int bin) -> double& {
+            return seen[(std::size_t(half) * kCells + std::size_t(cell)) * bins + bin];
+        };
+        forEachShownLayer(b, V, layers, true, [&](const ShownLayer& shown) {
+            Vec3 radial;
+            coneHeight(b, cotPhi, shown.x, nullptr, &radial);
+            const double psi = std::atan2(glm::dot(radial, b.across), glm::dot(radial, ev));
+            const double u = (psi + analytic::kPi) / (2.0 * analytic::kPi);
+            const int bin = std::clamp(int(u * bins), 0, bins - 1);
+            at(shown.half, shown.cell, bin) += shown.share;
+        });
+        for (int k = 0; k < kCells; ++k) {
+            double total = 0.0;
+            for (int h = 0; h < 2; ++h) {
+                for (int i = 0; i < bins; ++i) total += at(h, k, i);
+            }
+            if (!(total > 1.0)) continue;
+            for (int h = 0; h < 2; ++h) {
+                for (int i = 0; i < bins; ++i) at(h, k, i) /= total;
+            }
+        }
+        return seen;
+    }
+
 private:
+    // A layer a chord of the view meets and what of it shows: its share of the chord's
+    // transmittance times the chord's weight, in half `half` (0 front, 1 rear) of cell `cell`.
+    struct ShownLayer {
+        int half, cell;
+        double share;
+        Vec3 x;
+        long cone;
+    };
+    // Every layer the view's chords meet along -V, cell by cell (the first half of the cells
+    // only unless `allCells`), until the chord is opaque.
+    template <class Visit>
+    void forEachShownLayer(const TracedBough& b, const Vec3& V, const LayerModel& layers,
+                           bool allCells, Visit&& visit) const
+    {
+        const Vec3 d = -V;
+        for (int k = 0; k < (allCells ? kCells : kCells / 2); ++k) {
+            for (int p = 0; p < mShadingChords.count; ++p) {
+                Vec3 o;
+                double tIn, tOut, weight;
+                if (!chord(b, d, b.across, k, p, mShadingChords, o, tIn, tOut, weight)) continue;
+                const double tMid = 0.5 * (tIn + tOut);
+                double T = 1.0;
+                layers.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
+                    if (T < kOpaque) return;
+                    const double share = T * hit.opacity;  // what this layer shows
+                    T *= 1.0 - hit.opacity;
+                    visit(ShownLayer{hit.t < tMid ? 0 : 1, k, share * weight, o + hit.t * d,
+                                     hit.cone});
+                });
+            }
+        }
+    }
+
     Chords mShadingChords, mOpacityChords;
 };
 
@@ -227,6 +277,13 @@ private:
 std::unique_ptr<BoughLaw> makeExactBoughLaw(int density)
 {
     return std::make_unique<ExactBoughLaw>(density);
+}
+
+std::vector<double> exactSeenByAzimuth(const TracedBough& b, const Vec3& V,
+                                       const LayerModel& layers, int density, int bins)
+{
+    if (bins < 1) throw std::invalid_argument("needle azimuths need at least one bin");
+    return ExactBoughLaw(density).seenByAzimuth(b, V, layers, bins);
 }
 
 }  // namespace pine::vdbtrace
