@@ -117,13 +117,16 @@ const BoughView& TracedBough::view() const
         view.alpha = shading.alpha;
         const analytic::ConeGeometry& cone = geometry.cone;
         for (std::size_t i = 0; i < e.towards.size(); ++i) {
-            const auto sums = analytic::coneSums(
-                cone,
-                analytic::coneIntegrals(cone.aperture_rad, axis, e.towards[i], e.V, exponent),
-                exponent);
             BoughLighting lit;
-            lit.front = analytic::meanReflectance(sums.front);
-            lit.rear = analytic::meanReflectance(sums.rear);
+            // A law that shades the needles does not read the faces' mean I^cyl.
+            if (!shadesNeedles) {
+                const auto sums = analytic::coneSums(
+                    cone,
+                    analytic::coneIntegrals(cone.aperture_rad, axis, e.towards[i], e.V, exponent),
+                    exponent);
+                lit.front = analytic::meanReflectance(sums.front);
+                lit.rear = analytic::meanReflectance(sums.rear);
+            }
             lit.transfer = shading.lights[i].transfer;
             lit.diffuse = shading.lights[i].diffuse;
             lit.specular = shading.lights[i].specular;

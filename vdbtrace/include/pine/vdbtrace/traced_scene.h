@@ -45,7 +45,8 @@ struct TracedBranch {
 
 /// What a bough looks like from one light with the camera where it is (section 6 inputs).
 struct BoughLighting {
-    analytic::FaceReflectance front, rear;  ///< I^cyl of each face (diffuse, specular)
+    /// I^cyl of each face (diffuse, specular); zero for a law that shades needles.
+    analytic::FaceReflectance front, rear;
     FrontRearProfile transfer;              ///< the bough law's, with self-shadowing
     FrontRearProfile diffuse, specular;     ///< the law's, where it shades needles
 };
