@@ -23,9 +23,9 @@
 // the three angles, for one light and a far camera), not once per bough. Three tables: the
 // view's opacity (theta_v, L) split by the needles' azimuth, the opacity from a light
 // (theta_l, L) and, with self-shadowing only, each light's transfer and reflectances
-// (theta_v, theta_l, |Delta|, L). How far this is from the exact
-// law over the parameter space is measured by CorrectedBoughLaw.AgreesWithTheExactLaw; on the
-// paper forest it computes 7,474 light nodes for 26,400 boughs (docs/models.md).
+// (theta_v, theta_l, |Delta|, L). How far this is from the exact law over the parameter space
+// is measured by CorrectedBoughLaw.AgreesWithTheExactLaw; with self-shadowing the paper forest
+// fills 7,474 light nodes for its 26,400 boughs (docs/models.md).
 #include "exact_bough_law.h"
 
 #include "pine/analytic/needle_shader.h"
@@ -49,6 +49,7 @@ namespace pine::vdbtrace {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr int kCells = kExactLawCells;
 
 // Knots per angle, evenly spaced: theta_v and theta_l over [0, pi], |Delta| over [0, pi]. 7.5,
 // 7.5 and 15 degrees.
@@ -169,8 +170,6 @@ Kind kindOf(const TracedBough& b, const LayerModel& layers)
 // The exact law tabulated for one kind of bough.
 class Tables {
 public:
-    static constexpr int kCells = kExactLawCells;
-
     Tables(const BoughLaw& exact, const TracedBough& like, const LayerModel& layers)
         : mExact(exact), mGeometry(like.geometry), mExponent(like.exponent), mLayers(layers),
           mReach(like.geometry.cone.needleLength_cm * std::cos(like.geometry.cone.aperture_rad)),
@@ -294,8 +293,6 @@ private:
     mutable std::array<std::once_flag, 8> mLightOnce;
     mutable std::array<std::unique_ptr<LazyTable<5>>, 8> mLight;
 };
-
-constexpr int kCells = Tables::kCells;
 
 // Each part's cells (kCells of them, one part after another) in reverse order: the values for
 // a light on the other side of the plane of the axis and the view.
