@@ -333,19 +333,29 @@ TEST(FaithfulModels, ABoughsShadowIsWhereItsNeedlesCastIt)
             upper += up / kRolls;
             through += lo / alone / kRolls;
         }
-        for (const int level : {1, 2, 3}) {
+        // Levels 1-3 with shadow_origin "needles", and levels 2-3 with "bough" (each bough's
+        // shadows once per frame: bough_shadows.h).
+        for (const auto& [level, origin] :
+             {std::pair{1, ShadowOrigin::Needles}, std::pair{2, ShadowOrigin::Needles},
+              std::pair{3, ShadowOrigin::Needles}, std::pair{2, ShadowOrigin::Bough},
+              std::pair{3, ShadowOrigin::Bough}}) {
             MultiscaleOptions m;
             m.forceLevel = level;
-            const auto [lo, up] = halves(renderMultiscale(ShadowedBoughs(towards, 1).traced, m));
-            const double alone =
-                halves(renderMultiscale(ShadowedBoughs(towards, 1, true).traced, m)).first;
-            std::printf("towards [%s] level %d against the needles: upper bough %.4f, lower "
-                        "(shadowed) %.4f, its error %+.4f of the upper's; the shadow lets "
-                        "through %.4f (needles %.4f)\n",
-                        towards.c_str(), level, up / upper, lo / lower, (lo - lower) / upper,
-                        lo / alone, through);
-            EXPECT_NEAR(up / upper, 1.0, 0.07) << towards << " level " << level;
-            EXPECT_NEAR(lo / alone, through, 0.05) << towards << " level " << level;
+            const auto rendered = [&](bool alone) {
+                ShadowedBoughs boughs(towards, 1, alone);
+                boughs.traced.shadowOrigin = origin;
+                return halves(renderMultiscale(boughs.traced, m));
+            };
+            const auto [lo, up] = rendered(false);
+            const double alone = rendered(true).first;
+            const char* name = origin == ShadowOrigin::Bough ? "bough" : "needles";
+            std::printf("towards [%s] level %d, shadows from the %s, against the needles: upper "
+                        "bough %.4f, lower (shadowed) %.4f, its error %+.4f of the upper's; the "
+                        "shadow lets through %.4f (needles %.4f)\n",
+                        towards.c_str(), level, name, up / upper, lo / lower,
+                        (lo - lower) / upper, lo / alone, through);
+            EXPECT_NEAR(up / upper, 1.0, 0.07) << towards << " level " << level << " " << name;
+            EXPECT_NEAR(lo / alone, through, 0.05) << towards << " level " << level << " " << name;
         }
     }
 }

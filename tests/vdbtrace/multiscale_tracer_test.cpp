@@ -246,7 +246,7 @@ TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
     scene.render.model.shadowOrigin = "sun";
     expectInputError([&] { buildTracedScene(scene); },
                      "fir.json: render.shadow_origin: unknown shadow origin 'sun' (known: "
-                     "needles, axis)");
+                     "needles, axis, bough)");
 }
 
 TEST(MultiscaleTracer, ConeLevelCrossesTheTrueCones)

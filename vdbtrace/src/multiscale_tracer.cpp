@@ -1,6 +1,7 @@
 #include "pine/vdbtrace/multiscale_tracer.h"
 
 #include "pine/analytic/needle_shader.h"
+#include "pine/vdbtrace/bough_shadows.h"
 #include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/ground_hit.h"
@@ -14,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -27,9 +29,9 @@ constexpr double kPi = analytic::kPi;
 class MultiscaleRayTracer final : public ShadingMethod::RayTracer, private LightTransport {
 public:
     MultiscaleRayTracer(const TracedScene& scene, const EffectsPlan& plan, int forceLevel,
-                        RenderStats& stats)
+                        const BoughShadows* boughShadows, RenderStats& stats)
         : mScene(scene), mPlan(plan), mSettings(scene.scene->render), mForceLevel(forceLevel),
-          mStats(stats), mSurfaces(scene, plan, *this, stats)
+          mBoughShadows(boughShadows), mStats(stats), mSurfaces(scene, plan, *this, stats)
     {
     }
 
@@ -73,6 +75,7 @@ private:
     const EffectsPlan& mPlan;
     const scenes::RenderSettings& mSettings;
     int mForceLevel;
+    const BoughShadows* mBoughShadows;  ///< shadow_origin "bough" with shadows, else null
     RenderStats& mStats;
     SurfaceShading mSurfaces;
     std::vector<Fragment> mFragments;
@@ -131,7 +134,12 @@ void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
             }
         }
     }
-    if (mPlan.shadowRays && !mScene.shadowsFromNeedles) {
+    if (mBoughShadows && level == 2) {
+        for (std::size_t i = 0; i < lights; ++i) {
+            mLight[i].irradiance *= mBoughShadows->transmittance(
+                index, i, ray.origin + tRef * ray.direction, mStats);
+        }
+    } else if (mPlan.shadowRays && mScene.shadowOrigin == ShadowOrigin::Axis) {
         for (std::size_t i = 0; i < lights; ++i) {
             mLight[i].irradiance *= mSurfaces.shadow(i, ray.origin + tRef * ray.direction,
                                                      ray.width(tRef), index);
@@ -357,7 +365,7 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     Fragment rear{tMid, rearPart(view.alpha.rear), Vec3(0.0), Vec3(0.0), 3, true, b.tree};
     // The light at the chord's middle, or with shadow_origin "axis" where the ray passes the
     // axis.
-    const double tLight = mScene.shadowsFromNeedles ? tMid : p.t;
+    const double tLight = mScene.shadowOrigin == ShadowOrigin::Axis ? p.t : tMid;
     mLight.resize(mScene.lights.size());
     for (std::size_t i = 0; i < mLight.size(); ++i) {
         const BoughLighting& lit = view.lighting[i];
@@ -367,7 +375,10 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         const double tf = transfer.front.overFootprint(xi, R, w);
         const double tr = rearPart(transfer.rear);
         mStats.selfShadowEvaluations += mPlan.selfShadowing ? 2 : 0;
-        if (mPlan.shadowRays && !mScene.shadowsFromNeedles) {
+        if (mBoughShadows) {
+            mLight[i].irradiance *=
+                mBoughShadows->transmittance(index, i, ray.origin + tMid * ray.direction, mStats);
+        } else if (mPlan.shadowRays && mScene.shadowOrigin == ShadowOrigin::Axis) {
             mLight[i].irradiance *= mSurfaces.shadow(i, ray.origin + p.t * ray.direction, w, index);
         } else if (mPlan.shadowRays) {
             // Each half's needles that reflect the light lie along its half of the chord:
@@ -479,6 +490,9 @@ public:
     Multiscale(const TracedScene& scene, const MultiscaleOptions& options)
         : mScene(scene), mPlan(EffectsPlan::from(scene.scene->effects)), mOptions(options)
     {
+        if (mPlan.shadowRays && scene.shadowOrigin == ShadowOrigin::Bough) {
+            mBoughShadows = std::make_unique<BoughShadows>(scene, mPlan.selfShadowing);
+        }
     }
     int samplesPerPixel() const override { return 1; }
     ConeRay sample(const ConeCamera& camera, int x, int y, int) const override
@@ -487,13 +501,15 @@ public:
     }
     std::unique_ptr<RayTracer> rayTracer(RenderStats& stats) const override
     {
-        return std::make_unique<MultiscaleRayTracer>(mScene, mPlan, mOptions.forceLevel, stats);
+        return std::make_unique<MultiscaleRayTracer>(mScene, mPlan, mOptions.forceLevel,
+                                                     mBoughShadows.get(), stats);
     }
 
 private:
     const TracedScene& mScene;
     EffectsPlan mPlan;
     MultiscaleOptions mOptions;
+    std::unique_ptr<BoughShadows> mBoughShadows;  ///< this frame's, when the scene asks
 };
 
 }  // namespace

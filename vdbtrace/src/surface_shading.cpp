@@ -14,10 +14,15 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
                                const ShadowSamples* samples)
 {
     // One point at x when no samples are given.
-    static const ShadowSamples kOrigin{Vec3(0.0), {{0.0, 1.0}}};
+    static const ShadowSamples kOrigin{Vec3(0.0), Vec3(0.0), {{0.0, 1.0}}};
     const ShadowSamples& at = samples && !samples->points.empty() ? *samples : kOrigin;
-    double reach = 0.0;  // of the points from x
-    for (const ShadowSamples::Point& q : at.points) reach = std::max(reach, std::abs(q.offset_cm));
+    double reach = 0.0;   // of the points from x, across the light
+    double behind = 0.0;  // of the farthest point from the light beyond x
+    for (const ShadowSamples::Point& q : at.points) {
+        reach = std::max(reach, q.sideways_cm == 0.0 ? std::abs(q.offset_cm)
+                                                      : std::hypot(q.offset_cm, q.sideways_cm));
+        behind = std::max(behind, -q.towardsLight_cm);
+    }
     double tMax;
     const ConeRay ray =
         scene.lights[light].shadowCone(x, footprint_cm + 2.0 * reach, tMax);
@@ -26,14 +31,14 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
     // Each point's transmittance so far.
     thread_local std::vector<double> T;
     T.assign(at.points.size(), 1.0);
-    scene.bvh.query(ray, tMax, [&](std::uint32_t index) {
+    scene.bvh.query(ray, tMax + behind, [&](std::uint32_t index) {
         if (index == self) return true;
         const bool branch = scene.isBranch(index);
         if (!branch && !throughBoughs) return true;
         const Vec3 a = branch ? scene.branches[index].base_cm : scene.bough(index).base_cm;
         const Vec3 b = branch ? scene.branches[index].tip_cm : scene.bough(index).stripEnd_cm;
         Passage p;
-        if (!closestPassage(ray, a, b, p) || !(p.t < tMax)) return true;
+        if (!closestPassage(ray, a, b, p) || !(p.t < tMax + behind)) return true;
         // The points' lines pass the occluder shifted along its strip by their offsets (scaled
         // towards a point light), each read with the footprint's own width.
         const Vec3 n = stripAcross(glm::normalize(b - a), ray.direction);
@@ -41,10 +46,18 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         const double gap = reach > 0.0 ? glm::dot(c - (a + p.s * (b - a)), n) : p.gap;
         const double scale = scene.lights[light].directional ? 1.0 : p.t / tMax;
         const double along = glm::dot(at.across, n) * scale;
+        const double aside = glm::dot(at.sideways, n) * scale;
         const double w = pointWidth * ray.width(p.t);
         bool dark = true;  // every point: nothing further shows
         for (std::size_t k = 0; k < T.size(); ++k) {
-            const double g = gap + along * at.points[k].offset_cm;
+            const ShadowSamples::Point& q = at.points[k];
+            if (!(p.t < tMax - q.towardsLight_cm)) {  // the occluder lies beyond this point
+                dark = dark && T[k] < 1e-4;
+                continue;
+            }
+            const double g = q.sideways_cm == 0.0
+                                 ? gap + along * q.offset_cm
+                                 : gap + along * q.offset_cm + aside * q.sideways_cm;
             const double alpha =
                 branch ? stripCoverage(g, scene.branches[index].radius_cm, w)
                        : scene.bough(index).opacityFromLight(light).overFootprint(

@@ -200,7 +200,7 @@ void computeLawProfiles(const TracedScene& scene)
     });
 }
 
-std::vector<std::string> shadowOriginNames() { return {"needles", "axis"}; }
+std::vector<std::string> shadowOriginNames() { return {"needles", "axis", "bough"}; }
 
 TracedScene buildTracedScene(const scenes::Scene& scene)
 {
@@ -217,20 +217,21 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
     const LayerModel& layers = chosen("layer_model", [&]() -> const LayerModel& {
         return layerModel(model.layerModel);
     });
-    const bool fromNeedles = chosen("shadow_origin", [&] {
+    const ShadowOrigin origin = chosen("shadow_origin", [&] {
         const std::vector<std::string> known = shadowOriginNames();
-        if (std::find(known.begin(), known.end(), model.shadowOrigin) == known.end()) {
+        const auto it = std::find(known.begin(), known.end(), model.shadowOrigin);
+        if (it == known.end()) {
             throw InputError("unknown shadow origin '" + model.shadowOrigin +
-                             "' (known: needles, axis)");
+                             "' (known: needles, axis, bough)");
         }
-        return model.shadowOrigin == "needles";
+        return ShadowOrigin(it - known.begin());
     });
     const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
     TracedScene out;
     out.scene = &scene;
     out.layers = &layers;
     out.boughLaw = law;
-    out.shadowsFromNeedles = fromNeedles;
+    out.shadowOrigin = origin;
     out.lights = unifiedLights(scene);
     out.trees.resize(scene.trees.size());
     tbb::parallel_for(std::size_t(0), scene.trees.size(), [&](std::size_t i) {

@@ -78,7 +78,8 @@ struct ModelOverrides {
                        "theirs (render.extinction_law)")
             ->check(CLI::IsMember(bake::extinctionLawNames()));
         cmd.add_option("--shadow-origin", shadowOrigin,
-                       "multiscale: where a bough hit's shadow cone stands for "
+                       "multiscale: where a bough hit's shadow cone stands for; bough: "
+                       "levels 2-3 read each bough's shadows, traced once a frame "
                        "(render.shadow_origin)")
             ->check(CLI::IsMember(vdbtrace::shadowOriginNames()));
         cmd.add_option("--level-blend", levelBlend,

@@ -17,15 +17,17 @@ namespace pine::vdbtrace {
 inline constexpr std::size_t kNoPrimitive = std::size_t(-1);
 
 /// Where the needles lie that one shadow stands for (a bough's needles on a camera ray): points
-/// offset from the shadow's origin along `across` (unit, perpendicular to the light), each
-/// with the weight of the light it reflects to the pixel. The shadow is their weighted mean
-/// transmittance, each occluder read where each point's own shadow line passes it: what the
+/// offset from the shadow's origin along `across` and `sideways` (unit, perpendicular to the
+/// light and to each other), and towards the light, each with the weight of the light it
+/// reflects to the pixel. The shadow is their weighted mean transmittance, each occluder read
+/// where each point's own shadow line passes it, if it passes before the point: what the
 /// explicit needles' shadow rays, one from each needle, average to.
 struct ShadowSamples {
     struct Point {
         double offset_cm, weight;
+        double sideways_cm = 0.0, towardsLight_cm = 0.0;
     };
-    Vec3 across{0.0};
+    Vec3 across{0.0}, sideways{0.0};
     std::vector<Point> points;
 };
 

@@ -115,6 +115,13 @@ TracedBough makeTracedBough(const BoughDescription& description, const Vec3& eye
                             const std::vector<Light>& lights, const BoughLaw& law,
                             const LayerModel& layers, const BoughLawNeeds& needs = {});
 
+/// render.shadow_origin (docs/models.md "Shadow origin").
+enum class ShadowOrigin {
+    Needles,  ///< a bough hit's shadow cone stands for where the needles it shows lie
+    Axis,     ///< one line from the chord's middle (section 7's shadow ray per bough)
+    Bough,    ///< levels 2-3 read the bough's own shadows, once per frame (bough_shadows.h)
+};
+
 struct TracedScene {
     const scenes::Scene* scene = nullptr;
     std::vector<scenes::Tree> trees;
@@ -126,9 +133,8 @@ struct TracedScene {
     /// The bough law the boughs were made with: this scene's own (BoughLaw::fresh), which the
     /// boughs point to.
     std::shared_ptr<const BoughLaw> boughLaw;
-    /// render.shadow_origin "needles": a bough hit's shadow cone stands for where the needles
-    /// it shows lie (ShadowSamples); "axis": one line from the chord's middle.
-    bool shadowsFromNeedles = true;
+    /// render.shadow_origin: where a bough hit's shadow stands for.
+    ShadowOrigin shadowOrigin = ShadowOrigin::Needles;
 
     bool isBranch(std::size_t primitive) const { return primitive < branches.size(); }
     const TracedBough& bough(std::size_t primitive) const
@@ -141,7 +147,7 @@ struct TracedScene {
 /// parallel, as a render would on first use: for timing a render without them.
 void computeLawProfiles(const TracedScene& scene);
 
-/// The values of render.shadow_origin, the faithful one first.
+/// The values of render.shadow_origin, the faithful one first, in ShadowOrigin's order.
 std::vector<std::string> shadowOriginNames();
 
 /// Grows every tree and prepares the scene for its camera under the scene's bough law and
