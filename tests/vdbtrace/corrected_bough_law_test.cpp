@@ -5,6 +5,7 @@
 // the paper's bough among them. Each quantity level 3 reads (the view's coverage, each half's
 // transfer and reflectances, the opacity from a light) is compared as the strip's mean and
 // cell by cell.
+#include "pine/analytic/direction.h"
 #include "pine/vdbtrace/bough_law.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/traced_scene.h"
@@ -23,7 +24,7 @@
 namespace pine::vdbtrace {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = analytic::kPi;
 
 Vec3 onSphere(std::mt19937& rng)
 {

@@ -28,6 +28,7 @@
 // fills 7,474 light nodes for its 26,400 boughs (docs/models.md).
 #include "exact_bough_law.h"
 
+#include "pine/analytic/direction.h"
 #include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/bough_law.h"
 #include "pine/vdbtrace/layer_model.h"
@@ -48,7 +49,7 @@
 namespace pine::vdbtrace {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = analytic::kPi;
 constexpr int kCells = kExactLawCells;
 
 // Knots per angle, evenly spaced: theta_v and theta_l over [0, pi], |Delta| over [0, pi]. 7.5,

@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <cmath>
 
 namespace pine::vdbtrace {
 
@@ -19,8 +20,7 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
     double reach = 0.0;   // of the points from x, across the light
     double behind = 0.0;  // of the farthest point from the light beyond x
     for (const ShadowSamples::Point& q : at.points) {
-        reach = std::max(reach, q.sideways_cm == 0.0 ? std::abs(q.offset_cm)
-                                                      : std::hypot(q.offset_cm, q.sideways_cm));
+        reach = std::max(reach, std::hypot(q.offset_cm, q.sideways_cm));
         behind = std::max(behind, -q.towardsLight_cm);
     }
     double tMax;
@@ -55,9 +55,7 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
                 dark = dark && T[k] < 1e-4;
                 continue;
             }
-            const double g = q.sideways_cm == 0.0
-                                 ? gap + along * q.offset_cm
-                                 : gap + along * q.offset_cm + aside * q.sideways_cm;
+            const double g = gap + along * q.offset_cm + aside * q.sideways_cm;
             const double alpha =
                 branch ? stripCoverage(g, scene.branches[index].radius_cm, w)
                        : scene.bough(index).opacityFromLight(light).overFootprint(

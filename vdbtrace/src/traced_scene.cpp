@@ -5,6 +5,7 @@
 #include "pine/bake/tree_boughs.h"
 #include "pine/scenes/colours.h"
 #include "pine/support/input_error.h"
+#include "pine/support/registry.h"
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/layer_model.h"
 
@@ -200,7 +201,23 @@ void computeLawProfiles(const TracedScene& scene)
     });
 }
 
-std::vector<std::string> shadowOriginNames() { return {"needles", "axis", "bough"}; }
+namespace {
+
+const Registry<const ShadowOrigin>& shadowOrigins()
+{
+    static const Registry<const ShadowOrigin> origins = [] {
+        Registry<const ShadowOrigin> r("shadow origin");
+        r.add("needles", std::make_unique<const ShadowOrigin>(ShadowOrigin::Needles));
+        r.add("axis", std::make_unique<const ShadowOrigin>(ShadowOrigin::Axis));
+        r.add("bough", std::make_unique<const ShadowOrigin>(ShadowOrigin::Bough));
+        return r;
+    }();
+    return origins;
+}
+
+}  // namespace
+
+std::vector<std::string> shadowOriginNames() { return shadowOrigins().names(); }
 
 TracedScene buildTracedScene(const scenes::Scene& scene)
 {
@@ -217,15 +234,8 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
     const LayerModel& layers = chosen("layer_model", [&]() -> const LayerModel& {
         return layerModel(model.layerModel);
     });
-    const ShadowOrigin origin = chosen("shadow_origin", [&] {
-        const std::vector<std::string> known = shadowOriginNames();
-        const auto it = std::find(known.begin(), known.end(), model.shadowOrigin);
-        if (it == known.end()) {
-            throw InputError("unknown shadow origin '" + model.shadowOrigin +
-                             "' (known: needles, axis, bough)");
-        }
-        return ShadowOrigin(it - known.begin());
-    });
+    const ShadowOrigin origin =
+        chosen("shadow_origin", [&] { return shadowOrigins().get(model.shadowOrigin); });
     const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
     TracedScene out;
     out.scene = &scene;

@@ -147,7 +147,7 @@ struct TracedScene {
 /// parallel, as a render would on first use: for timing a render without them.
 void computeLawProfiles(const TracedScene& scene);
 
-/// The values of render.shadow_origin, the faithful one first, in ShadowOrigin's order.
+/// The values of render.shadow_origin, the faithful one first.
 std::vector<std::string> shadowOriginNames();
 
 /// Grows every tree and prepares the scene for its camera under the scene's bough law and
