@@ -68,7 +68,10 @@ private:
     // pixel: one shadow cone from depth tRef holding them all, each occluder read where each
     // one's shadow line passes it (ShadowSamples), so that an occluding bough is averaged over
     // where the needles lie, not read on one line (the explicit needles send a shadow ray from
-    // each).
+    // each). Each point also stands where its needles lie along the light, so that an
+    // occluder among them (the bough's own twig) shades only those behind it; and the pixel's
+    // footprint, a disc across the camera ray, spreads the lines across an occluder only as
+    // far as it spreads across that occluder's strip (ShadowSamples::footprintNormal).
     double shadowOf(const ConeRay& ray, std::size_t index, std::size_t light, double tRef);
 
     const TracedScene& mScene;
@@ -104,11 +107,14 @@ double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std:
     const Vec3& L = mLight[light].towards;
     const Vec3 across = ray.direction - glm::dot(ray.direction, L) * L;
     const double stretch = glm::length(across);  // of depth into offset across the light
+    const double lift = glm::dot(ray.direction, L);  // of depth into height towards the light
     mShadowSamples.across = stretch > 1e-9 ? across / stretch : Vec3(0.0);
     mShadowSamples.points.clear();
     for (const Depth& d : mDepths) {
-        mShadowSamples.points.push_back({(d.t - tRef) * stretch, d.weight});
+        mShadowSamples.points.push_back(
+            {(d.t - tRef) * stretch, d.weight, 0.0, (d.t - tRef) * lift});
     }
+    mShadowSamples.footprintNormal = ray.direction;
     return mSurfaces.shadow(light, ray.origin + tRef * ray.direction, ray.width(tRef), index,
                             &mShadowSamples);
 }

@@ -47,7 +47,9 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         const double scale = scene.lights[light].directional ? 1.0 : p.t / tMax;
         const double along = glm::dot(at.across, n) * scale;
         const double aside = glm::dot(at.sideways, n) * scale;
-        const double w = pointWidth * ray.width(p.t);
+        // The footprint's width across the occluder's strip (ShadowSamples::footprintNormal).
+        const double tilt = glm::dot(n, at.footprintNormal);
+        const double w = pointWidth * ray.width(p.t) * std::sqrt(std::max(0.0, 1.0 - tilt * tilt));
         bool dark = true;  // every point: nothing further shows
         for (std::size_t k = 0; k < T.size(); ++k) {
             const ShadowSamples::Point& q = at.points[k];
