@@ -231,6 +231,23 @@ cmp -s "$work/kept.json" "$work/small-firs.json" || fail "bench --json overwrote
 expect_error "bench even repeats" 2 "odd number" -- bench "$work/small-firs.json" --repeat 2
 
 "$vdbtrace" --help >/dev/null || fail "--help"
+# OpenImageIO (some 250 libraries, 0.3 s) loads with the first image, not before every command.
+LD_DEBUG=libs "$vdbtrace" --help 2>"$work/libs" >/dev/null
+grep -q "libOpenImageIO" "$work/libs" && fail "--help loads OpenImageIO"
+LD_DEBUG=libs "$vdbtrace" render "$src/scenes/bough.json" --resolution 8x6 --out "$work/lazy.exr" \
+    -q 2>"$work/libs" >/dev/null
+grep -q "libOpenImageIO" "$work/libs" || fail "writing an image does not load OpenImageIO"
+[ -s "$work/lazy.exr" ] || fail "no image written once OpenImageIO is loaded"
+# Without the module beside it (or in ../lib/pine) a render stops before its work, in one line.
+mkdir -p "$work/alone" && cp "$vdbtrace" "$work/alone/vdbtrace"
+"$work/alone/vdbtrace" render "$src/scenes/bough.json" --resolution 8x6 --out "$work/alone/a.exr" \
+    2>"$work/alone/err"
+status=$?
+[ "$status" -eq 2 ] || fail "a missing image module exits $status, not 2"
+grep -q "the image module libpine_image_codec.so is missing" "$work/alone/err" ||
+    fail "a missing image module: $(tail -1 "$work/alone/err")"
+grep -q "rendering" "$work/alone/err" && fail "a missing image module is found after the render"
+[ -e "$work/alone/a.exr" ] && fail "a missing image module left an image"
 "$vdbtrace" render --help >/dev/null || fail "render --help"
 "$vdbtrace" bench --help >/dev/null || fail "bench --help"
 

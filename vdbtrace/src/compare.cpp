@@ -4,6 +4,7 @@
 #include "pine/support/atomic_file.h"
 #include "pine/vdbtrace/compare_report.h"
 #include "pine/vdbtrace/dolly.h"
+#include "pine/vdbtrace/image.h"
 
 #include <algorithm>
 #include <chrono>
@@ -33,6 +34,7 @@ CompareRun runCompare(const CompareOptions& options)
     };
     const std::filesystem::path& dir = options.outDir;
     io::checkWritableFolder(dir);
+    loadImageIo();
     scenes::Scene scene = scenes::loadScene(options.sceneFile);
     if (options.model) options.model(scene.render.model);
     if (options.width > 0 && options.height > 0) {

@@ -1,13 +1,12 @@
-// Writing and reading frames through OpenImageIO: EXR with AOV layers and metadata, PNG
-// previews, the level map of the paper's Figure 12. Every write goes to a temporary name in
-// the destination folder and is renamed into place, so a crash or an error never leaves a
-// half-written file under the final name (a rename within one folder is atomic on POSIX).
+// Writing and reading frames through OpenImageIO (image_codec.h): EXR with AOV layers and
+// metadata, PNG previews, the level map of the paper's Figure 12. Every write goes to a
+// temporary name in the destination folder and is renamed into place, so a crash or an error
+// never leaves a half-written file under the final name (a rename within one folder is atomic
+// on POSIX).
 #include "pine/vdbtrace/image.h"
 
+#include "image_codec.h"
 #include "pine/support/atomic_file.h"
-
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
@@ -35,17 +34,7 @@ std::string channelOf(const std::string& aov)
 // Camera matrices, stored as pbrt-v4 stores them (m44f).
 bool isCameraMatrix(std::string_view key) { return key == "worldToCamera" || key == "worldToNDC"; }
 
-// OIIO error text may span lines; our errors are one line.
-std::string oneLine(std::string text)
-{
-    while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-    std::string out;
-    for (char c : text) {
-        if (c == '\n') out += "; ";
-        else out += c;
-    }
-    return out.empty() ? std::string("unknown error") : out;
-}
+using codec::oneLine;
 
 [[noreturn]] void fail(const char* what, const fs::path& path, const std::string& why)
 {
@@ -101,44 +90,17 @@ bool isStandardAttribute(std::string_view key)
 /// Writes pixels as `format` through the shared atomic writer (support/atomic_file.h): never
 /// half-written under `path`.
 void writeAtomically(const char* what, const char* format, const fs::path& path,
-                     const OIIO::ImageSpec& spec, const void* pixels,
+                     const codec::Header& header, const void* pixels,
                      const std::function<void()>& beforeRename = {})
 {
-    // libpng does not say when the disk is full (a truncated PNG, status 0, was seen): a
-    // format that can is written to memory first and its bytes written here, each checked.
-    // The memory outlives `out`, whose destructor may still close into it.
-    std::vector<unsigned char> bytes;
-    OIIO::Filesystem::IOVecOutput memory(bytes);
-    // Choose the plugin by name, not by the temporary's extension: writeExr("x.img") must
-    // still write OpenEXR.
-    auto out = OIIO::ImageOutput::create(format);
-    if (!out) fail(what, path, OIIO::geterror());
-    const bool viaMemory = std::string_view(format) == "png" && out->supports("ioproxy");
-    if (viaMemory && !out->set_ioproxy(&memory)) fail(what, path, out->geterror());
+    const codec::Codec& codec = codec::imageCodec();
     try {
         io::writeAtomically(path, [&](const fs::path& temporary) {
-            if (viaMemory) {
-                if (!out->open(temporary.string(), spec)) {
-                    throw std::runtime_error(oneLine(out->geterror()));
-                }
-                if (!out->write_image(spec.format, pixels) || !out->close()) {
-                    const std::string why = oneLine(out->geterror());
-                    out->close();
-                    throw std::runtime_error(why);
-                }
+            std::vector<unsigned char> bytes;
+            if (codec.write(format, header, pixels, temporary, bytes)) {
                 io::writeBytes(temporary,
                                {reinterpret_cast<const char*>(bytes.data()), bytes.size()});
-                return;
             }
-            if (!out->open(temporary.string(), spec)) {
-                throw std::runtime_error(oneLine(out->geterror()));
-            }
-            if (!out->write_image(spec.format, pixels)) {
-                const std::string why = oneLine(out->geterror());
-                out->close();
-                throw std::runtime_error(why);
-            }
-            if (!out->close()) throw std::runtime_error(oneLine(out->geterror()));
         }, beforeRename);
     } catch (const ImageError&) {
         throw;  // another image's, written by beforeRename
@@ -183,9 +145,13 @@ void levelColour(float level, float rgb[3])
 void writeBytesPng(const char* what, const fs::path& path, int width, int height,
                    const std::vector<std::uint8_t>& rgb)
 {
-    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:ColorSpace", "sRGB");
-    writeAtomically(what, "png", path, spec, rgb.data());
+    codec::Header header;
+    header.width = width;
+    header.height = height;
+    header.bytes = true;
+    header.channels = {"R", "G", "B"};
+    header.attributes = {{"oiio:ColorSpace", std::string("sRGB")}};
+    writeAtomically(what, "png", path, header, rgb.data());
 }
 
 }  // namespace
@@ -197,17 +163,20 @@ void writeExr(const Image& image, const std::filesystem::path& path, const Metad
     checkShape(image, what, path);
 
     const int channels = 4 + int(image.aovs.size());
-    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::FLOAT);
-    spec.channelnames = {"R", "G", "B", "A"};
-    for (const auto& entry : image.aovs) spec.channelnames.push_back(channelOf(entry.first));
-    spec.alpha_channel = 3;
+    codec::Header header;
+    header.width = image.width;
+    header.height = image.height;
+    header.channels = {"R", "G", "B", "A"};
+    for (const auto& entry : image.aovs) header.channels.push_back(channelOf(entry.first));
+    header.alphaChannel = 3;
     if (image.frameWidth > 0 && image.frameHeight > 0) {
-        spec.x = image.originX;
-        spec.y = image.originY;
-        spec.full_width = image.frameWidth;
-        spec.full_height = image.frameHeight;
+        header.x = image.originX;
+        header.y = image.originY;
+        header.fullWidth = image.frameWidth;
+        header.fullHeight = image.frameHeight;
     }
-    spec.attribute("compression", "zip");  // lossless: float values come back bit-exact
+    // Lossless: float values come back bit-exact.
+    header.attributes = {{"compression", std::string("zip")}};
     for (std::size_t i = 0; i < metadata.size(); ++i) {
         const auto& [key, value] = metadata[i];
         if (key.empty()) fail(what, path, "a metadata key is empty");
@@ -221,15 +190,7 @@ void writeExr(const Image& image, const std::filesystem::path& path, const Metad
                 fail(what, path, "metadata key '" + key + "' is given twice");
             }
         }
-        if (const auto* text = std::get_if<std::string>(&value)) {
-            spec.attribute(key, *text);
-        } else if (const auto* number = std::get_if<int>(&value)) {
-            spec.attribute(key, *number);
-        } else if (const auto* real = std::get_if<float>(&value)) {
-            spec.attribute(key, *real);
-        } else {
-            spec.attribute(key, OIIO::TypeDesc::TypeMatrix44, &matrix->m[0][0]);
-        }
+        header.attributes.push_back(metadata[i]);
     }
 
     const std::size_t pixels = std::size_t(image.width) * std::size_t(image.height);
@@ -240,7 +201,7 @@ void writeExr(const Image& image, const std::filesystem::path& path, const Metad
         std::size_t c = 4;
         for (const auto& entry : image.aovs) out[c++] = entry.second[p];
     }
-    writeAtomically(what, "openexr", path, spec, interleaved.data(), beforeRename);
+    writeAtomically(what, "openexr", path, header, interleaved.data(), beforeRename);
 }
 
 void writePng(const Image& image, const std::filesystem::path& path)
@@ -279,23 +240,25 @@ void writeLevelPng(const Image& image, const std::filesystem::path& path)
     writeBytesPng(what, path, image.width, image.height, rgb);
 }
 
+void loadImageIo() { codec::imageCodec(); }
+
 Image readExr(const std::filesystem::path& path, Metadata* metadata)
 {
     auto refuse = [&](const std::string& why) -> Image {
         throw ImageError("readExr: cannot read '" + path.string() + "': " + oneLine(why));
     };
-    auto in = OIIO::ImageInput::open(path.string());
-    if (!in) return refuse(OIIO::geterror());
-    if (std::string_view(in->format_name()) != "openexr") {
-        return refuse(std::string("it is ") + in->format_name() + ", not OpenEXR");
+    codec::Decoded decoded;
+    try {
+        decoded = codec::imageCodec().read(path, "openexr", "OpenEXR");
+    } catch (const ImageError&) {
+        throw;  // the module is missing
+    } catch (const std::exception& e) {
+        return refuse(e.what());
     }
-    const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0 || spec.depth != 1 || spec.deep) {
-        return refuse("not a flat 2D image");
-    }
+    const codec::Header& spec = decoded.header;
 
     auto channelIndex = [&](const std::string& name) {
-        const auto& names = spec.channelnames;
+        const auto& names = spec.channels;
         const auto it = std::find(names.begin(), names.end(), name);
         return it == names.end() ? -1 : int(it - names.begin());
     };
@@ -308,20 +271,17 @@ Image readExr(const std::filesystem::path& path, Metadata* metadata)
         }
     }
 
-    const int channels = spec.nchannels;
+    const int channels = int(spec.channels.size());
     const std::size_t pixels = std::size_t(spec.width) * std::size_t(spec.height);
-    std::vector<float> interleaved(pixels * std::size_t(channels));
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, interleaved.data())) {
-        return refuse(in->geterror());
-    }
+    const std::vector<float>& interleaved = decoded.pixels;
 
     Image image(spec.width, spec.height);
-    if (spec.x != 0 || spec.y != 0 || spec.full_width != spec.width ||
-        spec.full_height != spec.height) {
+    if (spec.x != 0 || spec.y != 0 || spec.fullWidth != spec.width ||
+        spec.fullHeight != spec.height) {
         image.originX = spec.x;
         image.originY = spec.y;
-        image.frameWidth = spec.full_width;
-        image.frameHeight = spec.full_height;
+        image.frameWidth = spec.fullWidth;
+        image.frameHeight = spec.fullHeight;
     }
     for (std::size_t p = 0; p < pixels; ++p) {
         const float* src = &interleaved[p * std::size_t(channels)];
@@ -331,7 +291,7 @@ Image readExr(const std::filesystem::path& path, Metadata* metadata)
         }
     }
     for (int c = 0; c < channels; ++c) {
-        const std::string& name = spec.channelnames[c];
+        const std::string& name = spec.channels[c];
         const bool suffixed = name.size() > kAovSuffix.size() && name.ends_with(kAovSuffix);
         if (!suffixed && name != kDepthChannel) continue;
         std::vector<float>& values =
@@ -343,23 +303,11 @@ Image readExr(const std::filesystem::path& path, Metadata* metadata)
 
     if (metadata) {
         metadata->clear();
-        for (const auto& attribute : spec.extra_attribs) {
-            const std::string key = attribute.name().string();
-            const OIIO::TypeDesc type = attribute.type();
+        for (const auto& [key, value] : spec.attributes) {
             if (!isCameraMatrix(key) && (isStandardAttribute(key) || isReservedKey(key))) {
                 continue;
             }
-            if (type == OIIO::TypeDesc::TypeMatrix44) {
-                Matrix44 matrix;
-                std::copy_n(static_cast<const float*>(attribute.data()), 16, &matrix.m[0][0]);
-                metadata->emplace_back(key, matrix);
-            } else if (type == OIIO::TypeDesc::STRING) {
-                metadata->emplace_back(key, attribute.get_string());
-            } else if (type == OIIO::TypeDesc::INT) {
-                metadata->emplace_back(key, attribute.get_int());
-            } else if (type == OIIO::TypeDesc::FLOAT) {
-                metadata->emplace_back(key, attribute.get_float());
-            }
+            metadata->emplace_back(key, value);
         }
         // The EXR header keeps no order of its own: sort so results are reproducible.
         std::sort(metadata->begin(), metadata->end(),

@@ -209,6 +209,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     io::checkOutputsApart({out, besideWith(out, ".png"),
                            levelPng ? besideWith(out, ".level.png") : fs::path(), statsFile},
                           inputs);
+    vdbtrace::loadImageIo();
     // Baked files first: a damaged one is refused before any work.
     std::optional<bake::TreeGrids> baked;
     std::vector<bake::BakeProvenance> bakedFrom;

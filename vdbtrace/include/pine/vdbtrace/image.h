@@ -79,6 +79,11 @@ void writePng(const Image& image, const std::filesystem::path& path);
 /// as 8-bit PNG, atomically. Throws ImageError if the image has no "level" AOV.
 void writeLevelPng(const Image& image, const std::filesystem::path& path);
 
+/// Loads what reads and writes images (OpenImageIO, in a module loaded on first use) now, once;
+/// throws ImageError (one line) if it cannot. A command that will write images calls this
+/// before its work, so that a broken build or install fails at once, not after the render.
+void loadImageIo();
+
 /// Reads an EXR written by writeExr back (tests, and `vdbtrace diff` later). `metadata`
 /// receives the string, int, float and matrix attributes other than OpenEXR/OIIO's own,
 /// sorted by key (EXR headers keep no order). A missing A channel reads as 1. Throws
