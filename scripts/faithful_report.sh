@@ -3,8 +3,9 @@
 # and the paper forest at 320 x 240 with self-shadowing added to their effects, rendered by the
 # geometry method (64 spp, the truth), by the multiscale method with the faithful models (the
 # default) and with --paper. Prints, per render, the foliage coverage (mean of the foliage
-# AOV) and the foliage-weighted luminance (sum of luminance x foliage over sum of foliage), for
-# the whole image and per tree (`vdbtrace diff` over the truth's "tree" AOV: the median and the
+# AOV) and the foliage's own mean luminance (the foliage_luminance AOV summed over the foliage
+# AOV summed: what lies behind partly covered pixels does not count), for the whole image and
+# per tree (`vdbtrace diff` over the truth's "tree" AOV: the median and the
 # worst tree's bias, and how many trees are off by more than 3%).
 #
 #   bash scripts/faithful_report.sh [DIR]     renders into DIR (default: a temporary folder)
@@ -26,11 +27,10 @@ for name in ("three-firs", "paper-forest"):
     json.dump(scene, open(f"{sys.argv[1]}/{name}.json", "w"), indent=1)
 PY
 measure() {
-  local exr=$1 coverage weighted
+  local exr=$1 coverage own
   coverage=$(oiiotool "$exr" --ch foliage.Y --printstats | awk '/Stats Avg/ {print $3}')
-  weighted=$(oiiotool "$exr" --ch R,G,B --chsum:weight=0.2126,0.7152,0.0722 "$exr" \
-               --ch foliage.Y --mul --printstats | awk '/Stats Avg/ {print $3}')
-  /usr/bin/python3 -c "print('%.5f %.5f' % ($coverage, $weighted / $coverage))"
+  own=$(oiiotool "$exr" --ch foliage_luminance.Y --printstats | awk '/Stats Avg/ {print $3}')
+  /usr/bin/python3 -c "print('%.5f %.5f' % ($coverage, $own / $coverage))"
 }
 per_tree() {  # errors.json of `vdbtrace diff`: per-tree biases, summarised
   /usr/bin/python3 - "$1" <<'PY'

@@ -92,7 +92,7 @@ grep -q '"shadow_rays"' "$work/b.json" || fail "stats lack shadow_rays"
 # the method computes, typed render time, samples and camera matrices.
 exr_info() { oiiotool --info -v "$1" 2>&1; }
 exr_info "$work/b.exr" >"$work/info"
-grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, level.Y, specular.Y, tree.Y" "$work/info" \
+grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, level.Y, specular.Y, tree.Y" "$work/info" \
     || fail "multiscale EXR channels: $(grep 'channel list' "$work/info")"
 grep -q "samplesPerPixel: 1$" "$work/info" || fail "multiscale EXR lacks samplesPerPixel 1"
 grep -q "renderTimeSeconds: [0-9.e-]*$" "$work/info" || fail "EXR lacks a float renderTimeSeconds"
@@ -116,7 +116,7 @@ oiiotool "$work/b.exr" --ch Z --printstats 2>&1 | grep -q "InfCount: [1-9]" || f
 "$vdbtrace" render "$src/scenes/bough.json" --method geometry --samples 2 --out "$work/g.exr" 2>/dev/null \
     || fail "geometry render failed"
 exr_info "$work/g.exr" >"$work/info"
-grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, specular.Y, tree.Y$" "$work/info" \
+grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, specular.Y, tree.Y$" "$work/info" \
     || fail "geometry EXR channels: $(grep 'channel list' "$work/info")"
 grep -q "samplesPerPixel: 2$" "$work/info" || fail "geometry EXR lacks samplesPerPixel 2"
 # A crop is the whole frame's pixels, as the EXR's data window; --resolution keeps the view;
@@ -176,7 +176,7 @@ if [ -x "$bake" ]; then
     "$vdbtrace" render "$src/scenes/bough.json" --method reference --grids "$work/t.vdb" \
         --subpixels 1 --out "$work/r.exr" 2>"$work/err" || fail "reference from grids: $(tail -1 "$work/err")"
     [ -s "$work/r.exr" ] || fail "reference wrote no image"
-    oiiotool --info -v "$work/r.exr" | grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, specular.Y$" \
+    oiiotool --info -v "$work/r.exr" | grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, specular.Y$" \
         || fail "reference EXR channels: $(oiiotool --info -v "$work/r.exr" | grep 'channel list')"
     head -c 1000 "$work/t.vdb" >"$work/cut.vdb" && cp "$work/t.vdb.json" "$work/cut.vdb.json"
     expect_error "damaged grids" 2 "manifest" -- render "$src/scenes/bough.json" --method reference \

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -44,7 +45,8 @@ TEST(TreeFoliage, SumsOverEachRegion)
     for (int i = 0; i < 6; ++i) {
         for (int c = 0; c < 3; ++c) image.rgba[4 * i + c] = grey[i];
     }
-    const std::vector<TreeFoliage> t = foliageByTree(image, treeRegions(image));
+    const std::vector<TreeFoliage> t =
+        foliageByTree(image, treeRegions(image), FoliageLuminance::Pixels);
     ASSERT_EQ(t.size(), 2u);
     EXPECT_EQ(t[0].tree, 0);
     EXPECT_EQ(t[0].pixels, 3u);
@@ -63,6 +65,17 @@ TEST(TreeFoliage, SumsOverEachRegion)
     EXPECT_NEAR(b[0].luminanceBias, 0.0, 1e-9);
     EXPECT_NEAR(b[1].luminanceBias, -0.5, 1e-6);
     EXPECT_NEAR(b[1].coverageBias, 0.0, 1e-9);
+
+    // The foliage's own luminance: its AOV summed over the region, over the coverage summed.
+    Image own = image;
+    own.aov("foliage_luminance") = {0.1f, 0.3f, 0.05f, 0.0f, 0.2f, 0.4f};
+    EXPECT_TRUE(hasOwnFoliageLuminance(own));
+    const std::vector<TreeFoliage> o = foliageByTree(own, treeRegions(own));
+    EXPECT_NEAR(o[0].luminance, (0.1 + 0.3 + 0.0) / 1.5, 1e-6);
+    EXPECT_NEAR(o[1].luminance, (0.05 + 0.2 + 0.4) / 2.0, 1e-6);
+    // Measured the pixels' way unless both images have it.
+    EXPECT_NEAR(treeBiases(own, image, 0.0)[0].luminanceBias, 0.0, 1e-9);
+    EXPECT_THROW(foliageByTree(image, treeRegions(image)), ImageError);
 }
 
 // The three firs at low resolution, all of them or only tree `only`: the others moved behind
@@ -114,6 +127,51 @@ TEST(TreeFoliage, EveryMethodNamesTheTreeItsFoliageComesFrom)
         }
         EXPECT_GT(checked, 1000);
         EXPECT_GT(empty, 1000);
+    }
+}
+
+TEST(TreeFoliage, TheFoliagesOwnLuminanceIsWhatFoliageFragmentsGive)
+{
+    // A branch half covering the footprint, then a needle fragment, then the ground: the
+    // foliage gave what the needles reflect through the branch's gap, nothing of the others.
+    FrontToBack c;
+    c.add(Fragment{1.0, 0.5, Vec3(0.2), Vec3(0.0), 0, false, -1});
+    c.add(Fragment{2.0, 0.4, Vec3(0.1, 0.2, 0.3), Vec3(0.04), 3, true, 0});
+    c.add(Fragment{3.0, 1.0, Vec3(0.7), Vec3(0.0), 0, false, -1});
+    const SampleValue v = c.value();
+    EXPECT_NEAR(v.foliage, 0.5 * 0.4, 1e-12);
+    EXPECT_NEAR(v.foliageLuminance, 0.5 * luminance(Vec3(0.14, 0.24, 0.34)), 1e-12);
+}
+
+TEST(TreeFoliage, TheFoliagesOwnLuminanceDoesNotSeeWhatLiesBehind)
+{
+    // The three firs with a white sky and ground, then black: each tree's own luminance is
+    // unchanged (to float rounding), for explicit needles and the multiscale method alike,
+    // where the pixels' measure moves with the backdrop wherever foliage covers a pixel in
+    // part.
+    for (const bool geometry : {false, true}) {
+        std::vector<TreeFoliage> own[2], pixels[2];
+        for (int dark = 0; dark < 2; ++dark) {
+            scenes::Scene s = threeFirs();
+            s.render.background = Vec3(dark ? 0.0 : 1.0);
+            s.ground.albedo = Vec3(dark ? 0.0 : 1.0);
+            const TracedScene t = buildTracedScene(s);
+            GeometryOptions g;
+            g.samples = 4;
+            const Image image = geometry ? renderGeometry(t, g).image : renderMultiscale(t).image;
+            const std::vector<int> regions = treeRegions(image);
+            own[dark] = foliageByTree(image, regions, FoliageLuminance::Own);
+            pixels[dark] = foliageByTree(image, regions, FoliageLuminance::Pixels);
+        }
+        ASSERT_EQ(own[0].size(), 3u);
+        for (std::size_t k = 0; k < 3; ++k) {
+            std::printf("%s tree %zu: own luminance %.5f / %.5f, the pixels' %.5f / %.5f (white "
+                        "/ black backdrop)\n",
+                        geometry ? "geometry" : "multiscale", k, own[0][k].luminance,
+                        own[1][k].luminance, pixels[0][k].luminance, pixels[1][k].luminance);
+            EXPECT_NEAR(own[0][k].luminance / own[1][k].luminance, 1.0, 1e-5);
+            EXPECT_GT(pixels[0][k].luminance / pixels[1][k].luminance, 1.02);
+        }
     }
 }
 

@@ -16,14 +16,15 @@ namespace {
 
 // The AOV planes of kAovNames, in its order, created and looked up once per render.
 struct Aovs {
-    static_assert(std::size(kAovNames) == 6, "one plane per name of kAovNames");
+    static_assert(std::size(kAovNames) == 7, "one plane per name of kAovNames");
     explicit Aovs(Image& image)
         : level(image.aov(kAovNames[0]).data()), depth(image.aov(kAovNames[1]).data()),
           diffuse(image.aov(kAovNames[2]).data()), specular(image.aov(kAovNames[3]).data()),
-          foliage(image.aov(kAovNames[4]).data()), tree(image.aov(kAovNames[5]).data())
+          foliage(image.aov(kAovNames[4]).data()), tree(image.aov(kAovNames[5]).data()),
+          foliageLuminance(image.aov(kAovNames[6]).data())
     {
     }
-    float *level, *depth, *diffuse, *specular, *foliage, *tree;
+    float *level, *depth, *diffuse, *specular, *foliage, *tree, *foliageLuminance;
 };
 
 // A pixel's samples, summed, then written as its RGBA and AOVs.
@@ -35,6 +36,7 @@ public:
         mSpecular += v.specular;
         mAlpha += v.alpha;
         mFoliage += v.foliage;
+        mFoliageLuminance += v.foliageLuminance;
         mLevelSum += v.levelSum;
         for (int k = 0; k < 4; ++k) mLevelWeight[k] += v.levelWeight[k];
         mTrees.add(v.trees);
@@ -56,6 +58,7 @@ public:
         aovs.diffuse[i] = float(luminance(mDiffuse * w));
         aovs.specular[i] = float(luminance(mSpecular * w));
         aovs.foliage[i] = float(mFoliage * w);
+        aovs.foliageLuminance[i] = float(mFoliageLuminance * w);
         aovs.tree[i] = float(mTrees.dominant());
         // The pixel's coverage passes 1/2 at the ceil(S/2)-th nearest sample depth.
         const std::size_t half = std::size_t((mSamples + 1) / 2);
@@ -80,7 +83,7 @@ public:
     void clear()
     {
         mDiffuse = mSpecular = Vec3(0.0);
-        mAlpha = mFoliage = mLevelSum = 0.0;
+        mAlpha = mFoliage = mFoliageLuminance = mLevelSum = 0.0;
         for (double& w : mLevelWeight) w = 0.0;
         mTrees = {};
         mDepths.clear();  // keeps its capacity: no allocation per pixel
@@ -89,7 +92,7 @@ public:
 
 private:
     Vec3 mDiffuse{0.0}, mSpecular{0.0};
-    double mAlpha = 0.0, mFoliage = 0.0, mLevelSum = 0.0;
+    double mAlpha = 0.0, mFoliage = 0.0, mFoliageLuminance = 0.0, mLevelSum = 0.0;
     double mLevelWeight[4] = {0.0, 0.0, 0.0, 0.0};
     TreeShares<8> mTrees;
     std::vector<double> mDepths;

@@ -56,14 +56,22 @@ std::vector<int> treeRegions(const Image& segmentation)
     return region;
 }
 
-std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int>& regions)
+bool hasOwnFoliageLuminance(const Image& image)
+{
+    return image.aovs.count("foliage_luminance") > 0;
+}
+
+std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int>& regions,
+                                       FoliageLuminance measure)
 {
     const std::vector<float>& foliage = plane(image, "foliage");
     if (regions.size() != foliage.size()) {
         throw ImageError("tree regions of " + std::to_string(regions.size()) +
                          " pixels for an image of " + std::to_string(foliage.size()));
     }
-    std::map<int, TreeFoliage> trees;  // luminance holds sum(luminance x foliage) until the end
+    const std::vector<float>* own =
+        measure == FoliageLuminance::Own ? &plane(image, "foliage_luminance") : nullptr;
+    std::map<int, TreeFoliage> trees;  // luminance holds its sum over the region until the end
     for (std::size_t i = 0; i < regions.size(); ++i) {
         if (regions[i] < 0) continue;
         TreeFoliage& t = trees[regions[i]];
@@ -71,7 +79,7 @@ std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int
         ++t.pixels;
         const float* p = &image.rgba[4 * i];
         t.coverage += foliage[i];
-        t.luminance += luminance(Vec3(p[0], p[1], p[2])) * foliage[i];
+        t.luminance += own ? (*own)[i] : luminance(Vec3(p[0], p[1], p[2])) * foliage[i];
     }
     std::vector<TreeFoliage> out;
     for (auto& [id, t] : trees) {
@@ -87,8 +95,12 @@ std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double 
         throw ImageError("images differ in size");
     }
     const std::vector<int> regions = treeRegions(truth);
-    const std::vector<TreeFoliage> a = foliageByTree(image, regions);
-    const std::vector<TreeFoliage> b = foliageByTree(truth, regions);
+    // The same measure for both: their own where both images have it.
+    const FoliageLuminance measure = hasOwnFoliageLuminance(image) && hasOwnFoliageLuminance(truth)
+                                         ? FoliageLuminance::Own
+                                         : FoliageLuminance::Pixels;
+    const std::vector<TreeFoliage> a = foliageByTree(image, regions, measure);
+    const std::vector<TreeFoliage> b = foliageByTree(truth, regions, measure);
     std::vector<TreeBias> out;
     for (std::size_t k = 0; k < b.size(); ++k) {  // the same regions, so the same trees
         if (!(b[k].coverage >= minCoverage) || !(b[k].coverage > 0.0)) continue;

@@ -75,6 +75,9 @@ struct SampleValue {
     Vec3 diffuse{0.0}, specular{0.0};  ///< premultiplied
     double alpha = 0.0;                ///< accumulated coverage, at most 1
     double foliage = 0.0;              ///< the part of alpha that foliage fragments gave
+    /// The luminance that foliage fragments gave (premultiplied, as seen through what lies in
+    /// front): over `foliage`, the foliage's own mean luminance, whatever lies behind it.
+    double foliageLuminance = 0.0;
     double levelWeight[4] = {0.0, 0.0, 0.0, 0.0};  ///< the part each level gave (0: none)
     double levelSum = 0.0;             ///< sum over fragments of their part times level
     TreeShares<4> trees;               ///< the part of foliage each tree gave
@@ -96,6 +99,7 @@ public:
         mValue.specular += (1.0 - mValue.alpha) * f.specular;
         if (f.foliage) {
             mValue.foliage += weight;
+            mValue.foliageLuminance += (1.0 - mValue.alpha) * luminance(f.diffuse + f.specular);
             mValue.trees.add(f.tree, weight);
         }
         if (f.level > 0) {

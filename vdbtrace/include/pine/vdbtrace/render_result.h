@@ -15,8 +15,8 @@ namespace pine::vdbtrace {
 /// "specular" (luminance of each term), "foliage" (coverage by needles, at any scale), "tree"
 /// (the index in the scene's trees of the tree whose foliage covers most of the pixel, -1
 /// where none does or the method does not know: the reference's merged grids).
-inline constexpr const char* kAovNames[] = {"level",   "depth",   "diffuse",
-                                            "specular", "foliage", "tree"};
+inline constexpr const char* kAovNames[] = {"level",   "depth",   "diffuse",         "specular",
+                                            "foliage", "tree",    "foliage_luminance"};
 
 /// A rectangle of the camera's pixels, [x0, x1) x [y0, y1), row 0 at the top.
 struct PixelWindow {

@@ -17,19 +17,35 @@ namespace pine::vdbtrace {
 /// does. Throws ImageError without a "tree" AOV.
 std::vector<int> treeRegions(const Image& segmentation);
 
+/// How a tree's foliage luminance is measured.
+enum class FoliageLuminance {
+    /// The foliage's own: the "foliage_luminance" AOV (what foliage fragments gave, as seen)
+    /// summed over the region, over the "foliage" AOV summed: the foliage's mean luminance,
+    /// whatever lies behind it and however its coverage is spread over the pixels.
+    Own,
+    /// The pixels': their luminance weighted by "foliage", over "foliage" (images written
+    /// before the foliage_luminance AOV). Partly covered pixels bring in what lies behind
+    /// (the sky, the ground), so two methods that cover alike but spread their coverage
+    /// differently over the pixels measure differently.
+    Pixels,
+};
+
+/// Whether `image` has the "foliage_luminance" AOV (every render since it was added).
+bool hasOwnFoliageLuminance(const Image& image);
+
 /// One tree's foliage in an image, over its region.
 struct TreeFoliage {
     int tree = -1;
     std::size_t pixels = 0;  ///< in its region
     double coverage = 0.0;   ///< the "foliage" AOV summed over the region, in pixels
-    /// The foliage-weighted mean luminance of the region's pixels (sum of luminance x foliage
-    /// over the sum of foliage); 0 without foliage.
-    double luminance = 0.0;
+    double luminance = 0.0;  ///< the foliage's mean luminance (FoliageLuminance); 0 without
 };
 
 /// Per tree of `regions` (as treeRegions gives them, for an image of the same size), by
-/// increasing tree index. Throws ImageError for another size or an image without "foliage".
-std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int>& regions);
+/// increasing tree index. Throws ImageError for another size or an image without "foliage"
+/// (or, measured as Own, without "foliage_luminance").
+std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int>& regions,
+                                       FoliageLuminance measure = FoliageLuminance::Own);
 
 /// A tree's foliage in an image over the truth's: coverage and luminance as ratios - 1.
 struct TreeBias {
@@ -37,7 +53,8 @@ struct TreeBias {
     double coverageBias = 0.0, luminanceBias = 0.0;
 };
 
-/// Every tree of the truth's "tree" AOV, `image` against `truth`; trees whose truth covers
+/// Every tree of the truth's "tree" AOV, `image` against `truth`, measured Own where both have
+/// the AOV, else both as Pixels; trees whose truth covers
 /// fewer than `minCoverage` pixels (or none) are left out (their ratios are noise).
 std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double minCoverage = 20.0);
 
