@@ -15,7 +15,8 @@ for f in bin/vdbtrace bin/bake bin/analytic share/pine/plot_compare.py share/pin
     [ -e "$prefix/$f" ] || fail "not installed: $f"
 done
 # The image module, where the installed tools look for it (src/image_codec.h).
-find "$prefix" -path "*/pine/libpine_image_codec.so" | grep -q . || fail "not installed: the image module"
+find "$prefix" -path "*/pine/libpine_image_codec.so" | grep -q . ||
+    fail "not installed: the image module"
 cd /
 "$prefix/bin/vdbtrace" --version | grep -q "^vdbtrace [0-9]" || fail "installed vdbtrace --version"
 "$prefix/bin/vdbtrace" render "$prefix/share/pine/scenes/bough.json" --resolution 32x24 \

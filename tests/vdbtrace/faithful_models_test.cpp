@@ -259,8 +259,8 @@ namespace {
 // Two long paper boughs side-on, 6 cm apart one above the other, lit from above through each
 // other (`towards`: towards the light), the lower one in the upper one's shadow; `alone`
 // leaves the upper one out. With `twigs` each bough holds its twig (a branch 0.3 cm in radius
-// on its axis; the firs' branches start at 0.45 cm); `resolution` "W, H" sets the frame's pixels (a pixel
-// 0.17 cm wide at the default 320 x 240, 1.75 cm at 32 x 24).
+// on its axis; the firs' branches start at 0.45 cm); `resolution` "W, H" sets the frame's
+// pixels (a pixel 0.17 cm wide at the default 320 x 240, 1.75 cm at 32 x 24).
 struct ShadowedBoughs {
     scenes::Scene scene;
     TracedScene traced;
