@@ -1,6 +1,7 @@
 #include "pine/vdbtrace/bough_shadows.h"
 
 #include "pine/analytic/direction.h"
+#include "pine/vdbtrace/bough_law.h"
 #include "pine/vdbtrace/surface_shading.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -75,11 +76,7 @@ void BoughShadows::fill(std::size_t bough, std::size_t light, RenderStats& stats
     // The opacity of a chord of the bough seen from the camera, at offset xi on its strip.
     const FrontRearProfile& seen = b.view().alpha;
     const auto viewOpacity = [&](double xi) {
-        const double front = seen.front.overFootprint(xi, R, kPointWidth * R);
-        const double rear = seen.rear.overFootprint(xi, R, kPointWidth * R);
-        return std::min(0.999, b.rearComposite == RearComposite::Share
-                                   ? front + rear
-                                   : 1.0 - (1.0 - front) * (1.0 - rear));
+        return std::min(0.999, bothHalvesOpacity(seen, b.rearComposite, xi, R, kPointWidth * R));
     };
     double* out = &mValues[mFirst[bough * mScene.lights.size() + light]];
     ShadowSamples section;

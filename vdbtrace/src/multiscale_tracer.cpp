@@ -237,9 +237,8 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
         // footprint (the exact law's shares), the layers keep their order and shading and
         // take the law's coverage.
         if (coverage < 1.0 && covered > 0.0 && b.rearComposite == RearComposite::Share) {
-            const FrontRearProfile& alpha = b.view().alpha;
-            const double target = alpha.front.overFootprint(xi, b.radius_cm, w) +
-                                  alpha.rear.overFootprint(xi, b.radius_cm, w);
+            const double target =
+                bothHalvesOpacity(b.view().alpha, b.rearComposite, xi, b.radius_cm, w);
             const double k = std::min(target, 0.999) / covered;
             double was = 0.0, before = 0.0;  // covered in front, as composited and as scaled
             for (NeedleHit& h : mNeedleHits) {

@@ -53,16 +53,14 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         bool dark = true;  // every point: nothing further shows
         for (std::size_t k = 0; k < T.size(); ++k) {
             const ShadowSamples::Point& q = at.points[k];
-            if (!(p.t < tMax - q.towardsLight_cm)) {  // the occluder lies beyond this point
-                dark = dark && T[k] < 1e-4;
-                continue;
+            if (p.t < tMax - q.towardsLight_cm) {  // else the occluder lies beyond this point
+                const double g = gap + along * q.offset_cm + aside * q.sideways_cm;
+                const double alpha =
+                    branch ? stripCoverage(g, scene.branches[index].radius_cm, w)
+                           : scene.bough(index).opacityFromLight(light).overFootprint(
+                                 g, scene.bough(index).radius_cm, w);
+                T[k] *= 1.0 - alpha;
             }
-            const double g = gap + along * q.offset_cm + aside * q.sideways_cm;
-            const double alpha =
-                branch ? stripCoverage(g, scene.branches[index].radius_cm, w)
-                       : scene.bough(index).opacityFromLight(light).overFootprint(
-                             g, scene.bough(index).radius_cm, w);
-            T[k] *= 1.0 - alpha;
             dark = dark && T[k] < 1e-4;
         }
         return !dark;

@@ -30,6 +30,16 @@ enum class RearComposite {
     Share,
 };
 
+/// The opacity of a chord through both halves, their `alpha` profiles read over a footprint
+/// `w` wide at offset xi on a strip of half-width R, composited as `rear` says.
+inline double bothHalvesOpacity(const FrontRearProfile& alpha, RearComposite rear, double xi,
+                                double R, double w)
+{
+    const double front = alpha.front.overFootprint(xi, R, w);
+    const double back = alpha.rear.overFootprint(xi, R, w);
+    return rear == RearComposite::Share ? front + back : 1.0 - (1.0 - front) * (1.0 - back);
+}
+
 /// A bough as one light sees it with the camera where it is, under a law.
 struct BoughLightTransfer {
     /// Radiance of each half per unit I^cyl of its face and unit irradiance, with the
