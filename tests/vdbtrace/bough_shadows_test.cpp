@@ -38,10 +38,6 @@ struct Occluders {
         traced.branches = {{Vec3(-50.0, 0.0, 0.0), Vec3(50.0, 0.0, 0.0), 0.4},
                            {Vec3(1.0, -30.0, 6.0), Vec3(2.0, 30.0, 9.0), 0.7}};
         const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
-        std::vector<Aabb> boxes;
-        for (const TracedBranch& b : traced.branches) {
-            boxes.push_back(cylinderBounds(b.base_cm, b.tip_cm, b.radius_cm));
-        }
         for (const Vec3& at : {Vec3(0.0), Vec3(-3.0, 1.0, 4.0)}) {
             BoughDescription d;
             d.spec.base_cm = at + Vec3(-40.0, 0.0, 0.0);
@@ -50,10 +46,8 @@ struct Occluders {
             d.spec.needles.coneSpacing_cm = 0.9;
             traced.boughs.push_back(makeTracedBough(d, scene.camera.position_cm, traced.lights,
                                                     *traced.boughLaw, *traced.layers, needs));
-            const TracedBough& b = traced.boughs.back();
-            boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm));
         }
-        traced.bvh = Bvh(boxes);
+        indexPrimitives(traced);
     }
 };
 

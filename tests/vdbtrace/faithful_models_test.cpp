@@ -55,8 +55,7 @@ struct LongBough {
         traced.boughs.push_back(makeTracedBough(
             d, scene.camera.position_cm, traced.lights, boughLaw(model.boughLaw),
             layerModel(model.layerModel), BoughLawNeeds::from(EffectsPlan::from(scene.effects))));
-        const TracedBough& b = traced.boughs.back();
-        traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
+        indexPrimitives(traced);
     }
 };
 
@@ -156,11 +155,7 @@ struct RecedingBoughs {
                 d, scene.camera.position_cm, traced.lights, boughLaw(scene.render.model.boughLaw),
                 *traced.layers, needs));
         }
-        std::vector<Aabb> boxes;
-        for (const TracedBough& b : traced.boughs) {
-            boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm));
-        }
-        traced.bvh = Bvh(boxes);
+        indexPrimitives(traced);
     }
 };
 
@@ -276,12 +271,10 @@ struct ShadowedBoughs {
                                    "shadowed-boughs.json");
         traced = buildTracedScene(scene);
         const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
-        std::vector<Aabb> boxes;
         for (int k = alone ? 1 : 0; k < 2; ++k) {
             const Vec3 base(-100.0, 0.0, 3.0 - 6.0 * k), tip(100.0, 0.0, 3.0 - 6.0 * k);
             if (twigs) {
                 traced.branches.push_back(TracedBranch{base, tip, 0.3});
-                boxes.push_back(cylinderBounds(base, tip, 0.3));
             }
         }
         for (int k = alone ? 1 : 0; k < 2; ++k) {
@@ -294,10 +287,8 @@ struct ShadowedBoughs {
             traced.boughs.push_back(makeTracedBough(
                 d, scene.camera.position_cm, traced.lights,
                 boughLaw(scene.render.model.boughLaw), *traced.layers, needs));
-            const TracedBough& b = traced.boughs.back();
-            boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm));
         }
-        traced.bvh = Bvh(boxes);
+        indexPrimitives(traced);
     }
 };
 

@@ -164,8 +164,7 @@ SideOnCoverage renderSideOnBough(const analytic::ConeGeometry& cone, unsigned se
                    "fov_deg": 30, "resolution": [120, 90]})",
                "[0.2, -1, 0.5]");
     s.add(Vec3(-5, 0, 0), Vec3(1, 0, 0), 5.0, cone, seed);
-    const TracedBough& b = s.traced.boughs.front();
-    s.traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
+    indexPrimitives(s.traced);
     MultiscaleOptions level1;
     level1.forceLevel = 1;
     GeometryOptions options;
@@ -252,7 +251,7 @@ TEST(GeometryTracer, MatchesTheReferenceOnAThinBoughUpToTheLayersObliquity)
     const analytic::ConeGeometry cone{analytic::kPi / 8, 4.25, 0.01, 2};
     s.add(Vec3(-12, 0, 0), Vec3(1, 0, 0), 20.0, cone, 5);
     const TracedBough& b = s.traced.boughs.front();
-    s.traced.bvh = Bvh({cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm)});
+    indexPrimitives(s.traced);
     GeometryOptions options;
     options.samples = 64;
     const RenderResult geometry = renderGeometry(s.traced, options);

@@ -219,6 +219,23 @@ const Registry<const ShadowOrigin>& shadowOrigins()
 
 std::vector<std::string> shadowOriginNames() { return shadowOrigins().names(); }
 
+void indexPrimitives(TracedScene& scene)
+{
+    std::vector<Aabb> boxes;
+    std::vector<Sphere> spheres;
+    boxes.reserve(scene.branches.size() + scene.boughs.size());
+    spheres.reserve(boxes.capacity());
+    const auto add = [&](const Vec3& a, const Vec3& b, double radius) {
+        boxes.push_back(cylinderBounds(a, b, radius));
+        spheres.push_back({0.5 * (a + b), 0.5 * glm::length(b - a) + radius});
+    };
+    for (const TracedBranch& b : scene.branches) add(b.base_cm, b.tip_cm, b.radius_cm);
+    for (const TracedBough& b : scene.boughs) {
+        add(b.base_cm, b.conesEnd_cm, b.radius_cm + b.geometry.cone.needleRadius_cm);
+    }
+    scene.bvh = Bvh(boxes, std::move(spheres));
+}
+
 TracedScene buildTracedScene(const scenes::Scene& scene)
 {
     const scenes::ModelChoices& model = scene.render.model;
@@ -275,17 +292,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
                                        layers, needs);
     });
 
-    std::vector<Aabb> boxes;
-    boxes.reserve(out.branches.size() + out.boughs.size());
-    for (const TracedBranch& b : out.branches) {
-        boxes.push_back(cylinderBounds(b.base_cm, b.tip_cm, b.radius_cm));
-    }
-    for (const TracedBough& b : out.boughs) {
-        // Needles reach R from the axis and are r thick.
-        boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm,
-                                       b.radius_cm + b.geometry.cone.needleRadius_cm));
-    }
-    out.bvh = Bvh(boxes);
+    indexPrimitives(out);
     return out;
 }
 

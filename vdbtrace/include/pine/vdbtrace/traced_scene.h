@@ -143,6 +143,11 @@ struct TracedScene {
     }
 };
 
+/// Builds scene.bvh over its branches and boughs (in that order of primitive indices): the
+/// boxes query() culls by and the balls queryNearestFirst orders by, a bough's holding its
+/// cones' reach R and the needles' radius about the axis from the base to the cones' end.
+void indexPrimitives(TracedScene& scene);
+
 /// Computes every bough's law profiles now (view() and each light's opacityFromLight()), in
 /// parallel, as a render would on first use: for timing a render without them.
 void computeLawProfiles(const TracedScene& scene);
