@@ -1,13 +1,15 @@
 // The explicit-needle ground truth: solid cylinders in an Embree 3 BVH, point samples, shadow
 // rays, and the per-point integrands of the paper's eqs. (1) and (2).
 //
-// Cylinders are Embree *user* geometry, not RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE: a round
-// linear curve is a capsule (a hemisphere of radius r at each end adds pi r^2 to the needle's
-// projected area 2 r l, +1.8% for the paper's needle) in single precision, whereas section 4
-// integrates over a cylinder and the multiscale level 1 covers exactly its strip. Here Embree
-// only builds and walks the BVH; each candidate is intersected exactly, in double precision,
-// with the ray the sample really is (carried in the intersection context), as a flat-capped
-// solid cylinder.
+// A cylinder is what section 4 integrates over and what the multiscale level 1 covers exactly:
+// flat-capped, not RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE's capsule (a hemisphere of radius r at
+// each end adds pi r^2 to the needle's projected area 2 r l, +1.8% for the paper's needle).
+// Embree's RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE with equal radii at both ends and no
+// neighbours is that cylinder, intersected natively in single precision (NeedlePrimitive::
+// Curve, the default); its hit is intersected again here in double precision to be shaded.
+// NeedlePrimitive::Cylinder makes cylinders Embree *user* geometry: Embree only builds and
+// walks the BVH, and each candidate is intersected exactly, in double precision, with the ray
+// the sample really is (carried in the intersection context).
 #include "pine/vdbtrace/geometry_tracer.h"
 
 #include "pine/vdbtrace/effects_plan.h"
@@ -173,6 +175,19 @@ void cylinderOccludedFn(const RTCOccludedFunctionNArguments* args)
     }
 }
 
+// A shadow ray does not stop at the surface it leaves (a convex cylinder never shadows its own
+// lit side): Embree's native curves ask here.
+void curveOccludedFilterFn(const RTCFilterFunctionNArguments* args)
+{
+    const auto* ctx = reinterpret_cast<const RayContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] && RTCHitN_geomID(args->hit, args->N, i) == ctx->skipGeom &&
+            RTCHitN_primID(args->hit, args->N, i) == ctx->skipPrim) {
+            args->valid[i] = 0;
+        }
+    }
+}
+
 // Embree's device and scene, released whatever happens; Embree's allocations counted.
 class EmbreeScene {
 public:
@@ -211,15 +226,47 @@ public:
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
 
-    void attach(CylinderSet& set)
+    void attach(CylinderSet& set, NeedlePrimitive primitive)
     {
         if (set.cylinders.empty()) return;
+        if (primitive == NeedlePrimitive::Curve) {
+            attachCurves(set);
+            return;
+        }
         RTCGeometry g = rtcNewGeometry(mDevice, RTC_GEOMETRY_TYPE_USER);
         rtcSetGeometryUserPrimitiveCount(g, unsigned(set.cylinders.size()));
         rtcSetGeometryUserData(g, &set);
         rtcSetGeometryBoundsFunction(g, cylinderBoundsFn, nullptr);
         rtcSetGeometryIntersectFunction(g, cylinderIntersectFn);
         rtcSetGeometryOccludedFunction(g, cylinderOccludedFn);
+        rtcCommitGeometry(g);
+        set.geomID = rtcAttachGeometry(mScene, g);
+        rtcReleaseGeometry(g);
+        check();
+    }
+    // Each cylinder a segment of its own: two vertices (x, y, z, r), no flags (no neighbour,
+    // so both ends are capped flat).
+    void attachCurves(CylinderSet& set)
+    {
+        RTCGeometry g = rtcNewGeometry(mDevice, RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE);
+        const std::size_t n = set.cylinders.size();
+        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 2 * n));
+        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned), n));
+        check();
+        for (std::size_t i = 0; i < n; ++i) {
+            const Cylinder& c = set.cylinders[i];
+            const Vec3 tip = c.base + double(c.length) * Vec3(c.axis);
+            float* v = vertices + 8 * i;
+            for (int k = 0; k < 3; ++k) {
+                v[k] = float(c.base[k]);
+                v[4 + k] = float(tip[k]);
+            }
+            v[3] = v[7] = c.radius;
+            indices[i] = unsigned(2 * i);
+        }
+        rtcSetGeometryOccludedFilterFunction(g, curveOccludedFilterFn);
         rtcCommitGeometry(g);
         set.geomID = rtcAttachGeometry(mScene, g);
         rtcReleaseGeometry(g);
@@ -344,6 +391,22 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     rh.ray.mask = ~0u;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(mEmbree.scene(), &ctx.embree, &rh);
+    if (ctx.geomID == RTC_INVALID_GEOMETRY_ID && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+        // A native curve's hit: where the double ray enters that cylinder, or where Embree
+        // found it if the double ray only grazes it.
+        ctx.geomID = rh.hit.geomID;
+        ctx.primID = rh.hit.primID;
+        const CylinderSet& set = ctx.geomID == mNeedles.geomID ? mNeedles : mBranches;
+        double tIn, tOut;
+        if (intersectCylinder(ray.origin, ray.direction, set.cylinders[ctx.primID], tIn, tOut,
+                              ctx.cap) &&
+            tIn > 0.0) {
+            ctx.t = tIn;
+        } else {
+            ctx.t = rh.ray.tfar;
+            ctx.cap = false;
+        }
+    }
 
     const bool cylinder = ctx.geomID != RTC_INVALID_GEOMETRY_ID;
     if (!cylinder && !std::isfinite(tGround)) return;
@@ -460,8 +523,8 @@ public:
           mSampleWidth(1.0 / std::sqrt(double(mSamples)))
     {
         layOut(scene, mBranchSet, mNeedleSet);
-        mEmbree.attach(mBranchSet);
-        mEmbree.attach(mNeedleSet);
+        mEmbree.attach(mBranchSet, options.primitive);
+        mEmbree.attach(mNeedleSet, options.primitive);
         mEmbree.commit();
     }
 

@@ -53,7 +53,9 @@ RenderResult geometry(const TracedScene& scene, const MethodSettings& s,
 
 nlohmann::json describeGeometry(const scenes::Scene&, const MethodSettings& s)
 {
-    return {{"samples_per_pixel", s.geometry.samples}};
+    return {{"samples_per_pixel", s.geometry.samples},
+            {"needle_primitive",
+             s.geometry.primitive == NeedlePrimitive::Curve ? "curve" : "cylinder"}};
 }
 
 int oneCone(const MethodSettings&) { return 1; }

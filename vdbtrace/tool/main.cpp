@@ -416,7 +416,8 @@ BenchSummary benchRepeated(const scenes::Scene& scene, const std::string& method
 }
 
 int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
-          int geometrySamples, int repeats, const fs::path& jsonFile)
+          int geometrySamples, vdbtrace::NeedlePrimitive primitive, int repeats,
+          const fs::path& jsonFile)
 {
     if (!jsonFile.empty()) {
         io::checkWritable(jsonFile);
@@ -464,6 +465,7 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
     if (geometrySamples > 0) {
         vdbtrace::MethodSettings g;
         g.geometry.samples = geometrySamples;
+        g.geometry.primitive = primitive;
         const std::string label = "geometry " + std::to_string(geometrySamples) + " spp";
         const BenchSummary geo = benchRepeated(scene, "geometry", g, label, repeats);
         const double ratio = ms.median.cpuSeconds / geo.median.cpuSeconds;
@@ -617,6 +619,19 @@ void addMaxMemory(CLI::App& cmd, double& gib, const std::string& task)
         ->check(tool::positiveNumber());
 }
 
+/// --needle-primitive on `cmd`: what the geometry method's Embree walks.
+void addNeedlePrimitive(CLI::App& cmd, vdbtrace::NeedlePrimitive& primitive)
+{
+    const std::map<std::string, vdbtrace::NeedlePrimitive> names{
+        {"curve", vdbtrace::NeedlePrimitive::Curve},
+        {"cylinder", vdbtrace::NeedlePrimitive::Cylinder}};
+    cmd.add_option("--needle-primitive", primitive,
+                   "geometry: curve (Embree's native flat-capped cone curves, single precision) "
+                   "or cylinder (user geometry intersected in double precision, slower)")
+        ->transform(CLI::CheckedTransformer(names))
+        ->default_str("curve");
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -652,6 +667,7 @@ int main(int argc, char** argv)
                           "geometry: point samples per pixel")
         ->capture_default_str()
         ->check(CLI::Range(1, 65536));
+    addNeedlePrimitive(*renderCmd, settings.geometry.primitive);
     renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")
         ->required();
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
@@ -696,6 +712,8 @@ int main(int argc, char** argv)
                      "Samples per pixel of the geometry render timed beside it (0: none)")
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();
+    vdbtrace::NeedlePrimitive benchPrimitive = vdbtrace::NeedlePrimitive::Curve;
+    addNeedlePrimitive(*benchCmd, benchPrimitive);
     benchCmd
         ->add_option("--repeat", benchRepeats,
                      "Runs of each render (odd); the times are the median by CPU seconds, "
@@ -786,6 +804,7 @@ int main(int argc, char** argv)
             vdbtrace::runCompare(compare);
             return 0;
         }
-        return bench(sceneFile, scaling, model, benchGeometrySamples, benchRepeats, benchJson);
+        return bench(sceneFile, scaling, model, benchGeometrySamples, benchPrimitive,
+                     benchRepeats, benchJson);
     });
 }

@@ -22,7 +22,19 @@ struct GeometryBuild {
     std::size_t embreePeakBytes = 0;    ///< Embree's own allocations at their peak (the BVH)
 };
 
+/// What Embree walks for a cylinder (`--needle-primitive`).
+enum class NeedlePrimitive {
+    /// Embree's native RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE with equal radii: the same solid,
+    /// flat-capped cylinder, found by Embree's own single-precision intersector; the hit
+    /// Embree reports is then intersected again in double precision to be shaded.
+    Curve,
+    /// Embree user geometry: every candidate intersected in double precision, ties between
+    /// equal distances broken by primitive index (slower; for tests that need it).
+    Cylinder,
+};
+
 struct GeometryOptions {
+    NeedlePrimitive primitive = NeedlePrimitive::Curve;
     /// Point samples per pixel, on a digitally shifted (0,2)-sequence (Sobol' dimensions 1-2):
     /// every power of two of them is stratified in every elementary interval of the pixel.
     int samples = 16;
@@ -39,8 +51,7 @@ struct GeometryOptions {
 /// (fraction of samples hitting needles) and "level" (0: no scale is chosen here).
 /// Stats: coneRays = samples traced, shadowRays, needle/branch/ground hits, evaluations.
 /// The same image whatever the thread count: each sample's position depends only on (x, y,
-/// sample index, sampleSeed), and closest hits are resolved in double precision with ties
-/// broken by primitive index.
+/// sample index, sampleSeed), and a closest hit only on the ray and the BVH.
 /// @note With explicit geometry, shadows and self-shadowing are one mechanism (a needle's
 /// shadow ray meets the other needles of its own bough as it meets every other cylinder), so
 /// either scene effect turns shadow rays on. The ground casts no shadow, as in the other
