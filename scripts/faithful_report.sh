@@ -6,11 +6,13 @@
 # AOV) and the foliage's own mean luminance (the foliage_luminance AOV summed over the foliage
 # AOV summed: what lies behind partly covered pixels does not count), for the whole image and
 # per tree (`vdbtrace diff` over the truth's "tree" AOV: the median and the
-# worst tree's bias, and how many trees are off by more than 3%).
+# worst tree's bias, and how many trees are off by more than 3%). A second truth on another
+# sample pattern (`--sample-seed 1`) measured against the first shows what the truth's own
+# noise puts into those numbers: its per-tree difference is sqrt(2) times one truth's error.
 #
 #   bash scripts/faithful_report.sh [DIR]     renders into DIR (default: a temporary folder)
 #
-# Takes about a minute on 2 cores. Uses build/bin (build first) and oiiotool.
+# Takes about two minutes on 2 cores. Uses build/bin (build first) and oiiotool.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${VDBTRACE:-build/bin/vdbtrace}
@@ -47,16 +49,18 @@ for key in ("coverage_bias", "luminance_bias"):
           % (key, 100 * statistics.median(b), 100 * worst[key], worst["tree"], off, len(b)))
 PY
 }
-printf '%-14s %-10s %9s %9s %9s %9s\n' scene render coverage vs_truth luminance vs_truth
+printf '%-14s %-11s %9s %9s %9s %9s\n' scene render coverage vs_truth luminance vs_truth
 for name in three-firs paper-forest; do
   scene="$out/$name.json"
   "$bin" render "$scene" --method geometry --samples 64 --out "$out/$name.truth.exr" 2>/dev/null
+  "$bin" render "$scene" --method geometry --samples 64 --sample-seed 1 \
+      --out "$out/$name.truth-seed1.exr" 2>/dev/null
   "$bin" render "$scene" --out "$out/$name.faithful.exr" 2>/dev/null
   "$bin" render "$scene" --paper --out "$out/$name.paper.exr" 2>/dev/null
   read -r tc tl < <(measure "$out/$name.truth.exr")
-  for render in truth faithful paper; do
+  for render in truth truth-seed1 faithful paper; do
     read -r c l < <(measure "$out/$name.$render.exr")
-    /usr/bin/python3 -c "print('%-14s %-10s %9.5f %+8.1f%% %9.5f %+8.1f%%' % ('$name', '$render', $c, 100 * ($c / $tc - 1), $l, 100 * ($l / $tl - 1)))"
+    /usr/bin/python3 -c "print('%-14s %-11s %9.5f %+8.1f%% %9.5f %+8.1f%%' % ('$name', '$render', $c, 100 * ($c / $tc - 1), $l, 100 * ($l / $tl - 1)))"
     if [ "$render" != truth ]; then
       "$bin" diff "$out/$name.$render.exr" "$out/$name.truth.exr" --out "$out/$name.$render.diff" 2>/dev/null
       per_tree "$out/$name.$render.diff/errors.json"

@@ -119,6 +119,20 @@ exr_info "$work/g.exr" >"$work/info"
 grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, specular.Y, tree.Y$" "$work/info" \
     || fail "geometry EXR channels: $(grep 'channel list' "$work/info")"
 grep -q "samplesPerPixel: 2$" "$work/info" || fail "geometry EXR lacks samplesPerPixel 2"
+# --sample-seed 0 is the default pattern; another seed is another (independent) image. The
+# double-precision cylinders render what the native curves render but for rounding.
+"$vdbtrace" render "$src/scenes/bough.json" --method geometry --samples 2 --sample-seed 0 --out "$work/g0.exr" -q \
+    && idiff -q -fail 0 -failpercent 0 "$work/g.exr" "$work/g0.exr" >/dev/null 2>&1 \
+    || fail "--sample-seed 0 is not the default pattern"
+"$vdbtrace" render "$src/scenes/bough.json" --method geometry --samples 2 --sample-seed 1 --out "$work/g1.exr" -q \
+    || fail "--sample-seed 1 failed"
+idiff -q -fail 0.01 "$work/g.exr" "$work/g1.exr" >/dev/null 2>&1 && fail "--sample-seed 1 renders the same samples"
+"$vdbtrace" render "$src/scenes/bough.json" --method geometry --samples 2 --needle-primitive cylinder --out "$work/gc.exr" -q \
+    || fail "--needle-primitive cylinder failed"
+idiff -q -fail 1e-3 -failpercent 0.5 -warn 1e-3 -warnpercent 0.5 "$work/g.exr" "$work/gc.exr" >/dev/null 2>&1 \
+    || fail "curves and cylinders differ: $(idiff -fail 1e-3 "$work/g.exr" "$work/gc.exr" | tail -3)"
+expect_error "an unknown primitive" 2 "needle-primitive" -- render "$src/scenes/bough.json" --method geometry --out "$work/a.exr" --needle-primitive capsule
+expect_error "another method's option" 2 "sample-seed applies to --method geometry, not multiscale" -- render "$src/scenes/bough.json" --out "$work/a.exr" --sample-seed 3
 # A crop is the whole frame's pixels, as the EXR's data window; --resolution keeps the view;
 # --quiet leaves stderr empty on success.
 for m in multiscale geometry; do

@@ -606,8 +606,10 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
 
 /// The render options that belong to one method.
 constexpr std::pair<const char*, const char*> kMethodOptions[] = {
-    {"--voxel-size", "reference"}, {"--grids", "reference"},    {"--subpixels", "reference"},
-    {"--samples", "geometry"},     {"--force-level", "multiscale"}};
+    {"--voxel-size", "reference"},  {"--grids", "reference"},
+    {"--subpixels", "reference"},   {"--samples", "geometry"},
+    {"--sample-seed", "geometry"},  {"--needle-primitive", "geometry"},
+    {"--force-level", "multiscale"}};
 
 /// --max-memory (GiB) on `cmd`, for `task` ("a render").
 void addMaxMemory(CLI::App& cmd, double& gib, const std::string& task)
@@ -622,13 +624,15 @@ void addMaxMemory(CLI::App& cmd, double& gib, const std::string& task)
 /// --needle-primitive on `cmd`: what the geometry method's Embree walks.
 void addNeedlePrimitive(CLI::App& cmd, vdbtrace::NeedlePrimitive& primitive)
 {
-    const std::map<std::string, vdbtrace::NeedlePrimitive> names{
-        {"curve", vdbtrace::NeedlePrimitive::Curve},
-        {"cylinder", vdbtrace::NeedlePrimitive::Cylinder}};
-    cmd.add_option("--needle-primitive", primitive,
-                   "geometry: curve (Embree's native flat-capped cone curves, single precision) "
-                   "or cylinder (user geometry intersected in double precision, slower)")
-        ->transform(CLI::CheckedTransformer(names))
+    cmd.add_option_function<std::string>(
+           "--needle-primitive",
+           [&primitive](const std::string& name) {
+               primitive = name == "curve" ? vdbtrace::NeedlePrimitive::Curve
+                                           : vdbtrace::NeedlePrimitive::Cylinder;
+           },
+           "geometry: curve (Embree's native flat-capped cone curves, single precision) or "
+           "cylinder (user geometry intersected in double precision, slower)")
+        ->check(CLI::IsMember({"curve", "cylinder"}))
         ->default_str("curve");
 }
 
@@ -667,6 +671,10 @@ int main(int argc, char** argv)
                           "geometry: point samples per pixel")
         ->capture_default_str()
         ->check(CLI::Range(1, 65536));
+    renderCmd->add_option("--sample-seed", settings.geometry.sampleSeed,
+                          "geometry: another shift of the sample sequence, for an independent "
+                          "render with the same error statistics")
+        ->capture_default_str();
     addNeedlePrimitive(*renderCmd, settings.geometry.primitive);
     renderCmd->add_option("--out", out, "Output EXR; a PNG preview is written beside it")
         ->required();
