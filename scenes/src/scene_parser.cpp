@@ -143,6 +143,7 @@ RenderSettings readRender(const Json& value, const Where& where)
     s.model.layerModel = r.string("layer_model", s.model.layerModel);
     s.model.extinctionLaw = r.string("extinction_law", s.model.extinctionLaw);
     s.model.shadowOrigin = r.string("shadow_origin", s.model.shadowOrigin);
+    s.model.bark = r.string("bark", s.model.bark);
     s.needleLevelMax = r.number("needle_level_max", Range::above(0), s.needleLevelMax);
     s.coneLevelMax = r.number("cone_level_max", Range::above(0), s.coneLevelMax);
     if (!(s.coneLevelMax > s.needleLevelMax)) {

@@ -132,6 +132,7 @@ idiff -q -fail 0.01 "$work/g.exr" "$work/g1.exr" >/dev/null 2>&1 && fail "--samp
 idiff -q -fail 1e-3 -failpercent 0.5 -warn 1e-3 -warnpercent 0.5 "$work/g.exr" "$work/gc.exr" >/dev/null 2>&1 \
     || fail "curves and cylinders differ: $(idiff -fail 1e-3 "$work/g.exr" "$work/gc.exr" | tail -3)"
 expect_error "an unknown primitive" 2 "needle-primitive" -- render "$src/scenes/bough.json" --method geometry --out "$work/a.exr" --needle-primitive capsule
+expect_error "an unknown bark" 2 "bark" -- render "$src/scenes/bough.json" --out "$work/a.exr" --bark wood
 expect_error "another method's option" 2 "sample-seed applies to --method geometry, not multiscale" -- render "$src/scenes/bough.json" --out "$work/a.exr" --sample-seed 3
 # A crop is the whole frame's pixels, as the EXR's data window; --resolution keeps the view;
 # --quiet leaves stderr empty on success.

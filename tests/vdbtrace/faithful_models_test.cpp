@@ -403,5 +403,119 @@ TEST(FaithfulModels, AFarBoughsShadowSpreadsAsItsPixelsFootprintDoes)
     }
 }
 
+// The walks through a bough with a solid branch of radius 0.4 (render.bark "solid"): needles
+// inside the bark (within 0.4 of the axis, between the base and the tip) count for nothing, and
+// lines that miss the bark count as without it.
+TEST(FaithfulModels, TheBarkHidesTheNeedlesRootsAndNothingElse)
+{
+    scenes::Scene scene = scenes::parseScene(R"({"name": "bark",
+  "camera": {"position": [0, -60, 0], "look_at": [0, 0, 0]},
+  "lights": [{"type": "directional", "direction": [0, -1, 1]}],
+  "ground": {"type": "none"}, "species": {}, "trees": []})",
+                                             "bark.json");
+    const TracedScene traced = buildTracedScene(scene);
+    BoughDescription d;
+    d.spec.base_cm = Vec3(0.0);
+    d.spec.tip_cm = Vec3(12.0, 0.0, 0.0);
+    d.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
+    d.spec.needles.coneSpacing_cm = 0.9;
+    const TracedBough line = makeTracedBough(d, scene.camera.position_cm, traced.lights,
+                                             *traced.boughLaw, *traced.layers);
+    d.barkRadius_cm = 0.4;
+    const TracedBough solid = makeTracedBough(d, scene.camera.position_cm, traced.lights,
+                                              *traced.boughLaw, *traced.layers);
+    const auto needlesMet = [](const TracedBough& b, const Vec3& o, const Vec3& dir,
+                               double length = 1e9) {
+        double tIn, tOut, n = 0.0;
+        if (!layeredInterval(b, o, dir, tIn, tOut)) return 0.0;
+        forEachConeBand(b, o, dir, tIn, std::min(tOut, length), [&](const ConeBand& band) {
+            n += band.needles;
+            return true;
+        });
+        return n;
+    };
+    // Along the axis 0.2 cm from it, within the branch: every needle it passes is a root.
+    EXPECT_EQ(needlesMet(solid, Vec3(1.0, 0.2, 0.0), Vec3(1.0, 0.0, 0.0), 10.0), 0.0);
+    EXPECT_GT(needlesMet(line, Vec3(1.0, 0.2, 0.0), Vec3(1.0, 0.0, 0.0), 10.0), 0.5);
+    for (int k = 0; k < 40; ++k) {
+        const double offset = 0.05 * k + 0.013;  // of the line from the axis, cm
+        const Vec3 dir = glm::normalize(Vec3(0.3 * std::sin(k), 0.0, 1.0));
+        const Vec3 o(6.0 + 0.1 * k, offset, -10.0);
+        const double with = needlesMet(solid, o, dir), without = needlesMet(line, o, dir);
+        if (offset > 0.4) {
+            EXPECT_EQ(with, without) << "a line " << offset << " cm off the axis";
+        } else {
+            EXPECT_LT(with, without - 0.01) << "a line " << offset << " cm off the axis";
+            EXPECT_GE(with, 0.0);
+        }
+        // The paper's layers: the crossings kept are those outside the bark, all of them.
+        int kept = 0, outside = 0;
+        double tIn, tOut;
+        if (!layeredInterval(solid, o, dir, tIn, tOut)) continue;
+        forEachConeCrossing(solid, o, dir, tIn, tOut, [&](long, double t) {
+            EXPECT_FALSE(insideBark(solid, o + t * dir));
+            ++kept;
+        });
+        forEachConeCrossing(line, o, dir, tIn, tOut, [&](long, double t) {
+            if (!insideBark(solid, o + t * dir)) ++outside;
+        });
+        EXPECT_EQ(kept, outside);
+    }
+    // Beyond the tip the last cones' needles are not in the branch.
+    EXPECT_FALSE(insideBark(solid, Vec3(12.5, 0.1, 0.0)));
+    EXPECT_TRUE(insideBark(solid, Vec3(11.5, 0.1, 0.1)));
+}
+
+// Twigs 6 cm long on branches 0.3 cm thick, far apart, seen as the paper forest sees its
+// boughs (a footprint of two cone spacings): in the needles' truth the branch hides the
+// needles' roots, the darkest of them (7% of the coverage). With render.bark "solid" level 3
+// covers what the needles cover within 6%; with "line" (the paper's axis) it covers the roots
+// as well, 9-10% too much, and its self-shadowed needles are darker.
+TEST(FaithfulModels, ABranchHidesItsNeedlesRoots)
+{
+    const std::string json = R"({"name": "twigs",
+  "camera": {"position": [0, 0, 250], "look_at": [0, 1100, 40], "fov_deg": 30,
+             "resolution": [160, 120]},
+  "lights": [{"type": "directional", "direction": [-0.5, -0.6, 0.8]}],
+  "ground": {"type": "none"},
+  "species": {"twig": {
+     "lsystem": {"axiom": "[&F]", "iterations": 0, "branch_angle_deg": 60, "segment": 6,
+                 "trunk_radius": 0.3, "jitter_deg": 0},
+     "needles": {"base": {"aperture_deg": 22.5, "length": 4.25, "radius": 0.05, "per_cone": 12,
+                          "cone_spacing": 0.9}}}},
+  "trees": [{"scatter": {"species": "twig", "count": 250, "region": [[-300, 800], [300, 1300]],
+                         "min_spacing": 22, "seed": 3}}],
+  "effects": ["diffuse", "self_shadowing"],
+  "render": {"background": [0, 0, 0]}})";
+    struct Measured {
+        double coverage, luminance;  // the foliage's, and its own luminance per coverage
+    };
+    const auto measure = [](const RenderResult& r) {
+        double coverage = 0.0, own = 0.0;
+        for (const float f : r.image.aovs.at("foliage")) coverage += f;
+        for (const float f : r.image.aovs.at("foliage_luminance")) own += f;
+        return Measured{coverage, own / coverage};
+    };
+    scenes::Scene scene = scenes::parseScene(json, "twigs.json");
+    GeometryOptions g;
+    g.samples = 16;
+    const Measured truth = measure(renderGeometry(buildTracedScene(scene), g));
+    Measured level3[2];
+    for (const bool solid : {true, false}) {
+        scene.render.model.bark = solid ? "solid" : "line";
+        MultiscaleOptions m;
+        m.forceLevel = 3;
+        level3[solid ? 0 : 1] = measure(renderMultiscale(buildTracedScene(scene), m));
+    }
+    std::printf("twigs on 0.3 cm branches, level 3 over the needles: solid coverage %.3f "
+                "luminance %.3f, line %.3f %.3f\n",
+                level3[0].coverage / truth.coverage, level3[0].luminance / truth.luminance,
+                level3[1].coverage / truth.coverage, level3[1].luminance / truth.luminance);
+    EXPECT_NEAR(level3[0].coverage / truth.coverage, 1.0, 0.06);
+    EXPECT_GT(level3[1].coverage / truth.coverage, 1.07);
+    EXPECT_LT(std::abs(level3[0].luminance / truth.luminance - 1.0),
+              std::abs(level3[1].luminance / truth.luminance - 1.0));
+}
+
 }  // namespace
 }  // namespace pine::vdbtrace

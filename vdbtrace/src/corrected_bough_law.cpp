@@ -158,21 +158,43 @@ std::vector<double> cellsOf(const StripProfile& p)
     return cells;
 }
 
+// The bark's radius is a coordinate of the tables: knots every kBarkStep_cm, read linearly
+// between the two about a bough's radius, so that a forest's boughs, whose branches thin
+// continuously, share a few tables. What the bark hides grows about linearly with its radius
+// (needle length per area falls as 1 / rho), so the reading is near the exact law's.
+constexpr double kBarkStep_cm = 0.125;
+struct BarkPlace {
+    double below_cm, above_cm, t;  ///< the knots about the radius, and its place between
+};
+BarkPlace barkPlace(double radius_cm)
+{
+    const double u = std::max(0.0, radius_cm) / kBarkStep_cm, below = std::floor(u);
+    return {below * kBarkStep_cm, (below + 1.0) * kBarkStep_cm, u - below};
+}
+// (1 - t) a + t b, element by element.
+std::vector<double> mixed(std::vector<double> a, const std::vector<double>& b, double t)
+{
+    for (std::size_t i = 0; i < a.size(); ++i) a[i] += t * (b[i] - a[i]);
+    return a;
+}
+
 // Everything the exact law's profiles depend on besides the directions, the length and what a
 // render needs of it.
-using Kind = std::tuple<double, double, double, double, double, double, const LayerModel*>;
+using Kind =
+    std::tuple<double, double, double, double, double, double, double, const LayerModel*>;
 Kind kindOf(const TracedBough& b, const LayerModel& layers)
 {
     const analytic::ConeGeometry& c = b.geometry.cone;
     return {c.aperture_rad, c.needleLength_cm, c.needleRadius_cm, c.needlesPerCone,
-            b.geometry.coneSpacing_cm, b.exponent, &layers};
+            b.geometry.coneSpacing_cm, b.exponent, b.barkRadius_cm, &layers};
 }
 
 // The exact law tabulated for one kind of bough.
 class Tables {
 public:
     Tables(const BoughLaw& exact, const TracedBough& like, const LayerModel& layers)
-        : mExact(exact), mGeometry(like.geometry), mExponent(like.exponent), mLayers(layers),
+        : mExact(exact), mGeometry(like.geometry), mExponent(like.exponent),
+          mBark_cm(like.barkRadius_cm), mLayers(layers),
           mReach(like.geometry.cone.needleLength_cm * std::cos(like.geometry.cone.aperture_rad)),
           mView({kViewKnots, kCountKnots, kWithinKnots}, 2 * kCells * kAzimuthBins,
                 [this](const auto& i) {
@@ -247,6 +269,7 @@ private:
         d.spec.tip_cm = Vec3(0.0, 0.0, cones * mGeometry.coneSpacing_cm);
         d.spec.needles = mGeometry;
         d.exponent = mExponent;
+        d.barkRadius_cm = mBark_cm;
         TracedBough b =
             makeTracedBough(d, d.spec.tip_cm * 0.5 + 1e4 * V, {}, mExact, mLayers, {});
         b.across = Vec3(0.0, 1.0, 0.0);
@@ -287,6 +310,7 @@ private:
     const BoughLaw& mExact;
     analytic::BoughGeometry mGeometry;
     double mExponent;
+    double mBark_cm;  ///< the boughs' bark radius: a knot
     const LayerModel& mLayers;
     double mReach;  // l cos(phi), cm: how far the cones reach past the tip
     LazyTable<3> mView, mFromLight;
@@ -330,10 +354,17 @@ public:
                        const std::vector<Vec3>& towardsLights, const LayerModel& layers,
                        const BoughLawNeeds& needs) const override
     {
-        const Tables& t = tables(b, layers);
+        // Each table's values at the bough, mixed between the bark's two knots.
+        const BarkPlace bark = barkPlace(b.barkRadius_cm);
+        const Tables& t = tables(b, layers, bark.below_cm);
+        const Tables* above = bark.t > 0.0 ? &tables(b, layers, bark.above_cm) : nullptr;
+        const auto read = [&](auto&& value) {
+            return above ? mixed(value(t), value(*above), bark.t) : value(t);
+        };
         const Tables::Length length = t.length(b.length_cm);
         const double thetaV = angleTo(b.axis, V);
-        const std::vector<double> seen = t.viewSeen(thetaV, length);
+        const std::vector<double> seen =
+            read([&](const Tables& at) { return at.viewSeen(thetaV, length); });
         std::vector<double> alpha(2 * kCells, 0.0);
         for (std::size_t i = 0; i < seen.size(); ++i) alpha[i / kAzimuthBins] += seen[i];
         std::vector<std::vector<double>> lights;
@@ -341,8 +372,10 @@ public:
         for (const Vec3& L : towardsLights) {
             if (needs.transfer) {
                 const double azimuth = std::atan2(glm::dot(L, b.across), glm::dot(L, ev));
-                lights.push_back(t.lightValues(thetaV, angleTo(b.axis, L), std::abs(azimuth),
-                                               length, needs));
+                lights.push_back(read([&](const Tables& at) {
+                    return at.lightValues(thetaV, angleTo(b.axis, L), std::abs(azimuth), length,
+                                          needs);
+                }));
                 if (azimuth < 0.0) lights.back() = reversedCells(lights.back());
             } else {
                 lights.push_back(unshadowed(b, V, L, seen, alpha, ev, needs));
@@ -369,9 +402,13 @@ public:
     StripProfile opacityFromLight(const TracedBough& b, const Vec3& towardsLight,
                                   const LayerModel& layers) const override
     {
-        const Tables& t = tables(b, layers);
-        std::vector<double> cells =
-            t.fromLight(angleTo(b.axis, towardsLight), t.length(b.length_cm));
+        const BarkPlace bark = barkPlace(b.barkRadius_cm);
+        const auto read = [&](double bark_cm) {
+            const Tables& t = tables(b, layers, bark_cm);
+            return t.fromLight(angleTo(b.axis, towardsLight), t.length(b.length_cm));
+        };
+        std::vector<double> cells = read(bark.below_cm);
+        if (bark.t > 0.0) cells = mixed(cells, read(bark.above_cm), bark.t);
         for (double& c : cells) c = std::clamp(c, 0.0, 1.0);
         return StripProfile::sampled(cells);
     }
@@ -407,11 +444,14 @@ private:
         return v;
     }
 
-    const Tables& tables(const TracedBough& b, const LayerModel& layers) const
+    // The tables of b's kind with the bark at the knot bark_cm.
+    const Tables& tables(const TracedBough& b, const LayerModel& layers, double bark_cm) const
     {
+        TracedBough like = b;
+        like.barkRadius_cm = bark_cm;
         std::lock_guard<std::mutex> lock(mMutex);
-        auto& slot = mTables[kindOf(b, layers)];
-        if (!slot) slot = std::make_unique<Tables>(*mExact, b, layers);
+        auto& slot = mTables[kindOf(like, layers)];
+        if (!slot) slot = std::make_unique<Tables>(*mExact, like, layers);
         return *slot;
     }
 

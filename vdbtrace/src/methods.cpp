@@ -18,7 +18,8 @@ nlohmann::json describeMultiscale(const scenes::Scene& scene, const MethodSettin
     return {{"bough_law", scene.render.model.boughLaw},
             {"layer_model", scene.render.model.layerModel},
             {"shadow_origin", scene.render.model.shadowOrigin},
-            {"level_blend", scene.render.model.levelBlend}};
+            {"level_blend", scene.render.model.levelBlend},
+            {"bark", scene.render.model.bark}};
 }
 
 RenderResult reference(const TracedScene& scene, const MethodSettings& s,

@@ -279,7 +279,7 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
             mNeedleHits.push_back({j, needle, p.t, c});
         }
         return true;
-    });
+    }, /*hiddenInBark=*/false);
     shadeNeedles(ray, index, b, tIn, tOut, 1);
 }
 

@@ -161,6 +161,7 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
     const analytic::ConeGeometry& cone = b.geometry.cone;
     b.radius_cm = analytic::boughRadius(cone);
     b.layerOpacity = analytic::layerOpacity(cone);
+    b.barkRadius_cm = std::clamp(d.barkRadius_cm, 0.0, b.radius_cm);
     b.conesEnd_cm = b.tip_cm + cone.needleLength_cm * std::cos(cone.aperture_rad) * b.axis;
     b.needleAlbedo = d.spec.needleAlbedo;
     b.specularWeight = d.specularWeight;
@@ -215,9 +216,23 @@ const Registry<const ShadowOrigin>& shadowOrigins()
     return origins;
 }
 
+// render.bark: whether a bough's needles have their roots in a solid branch.
+const Registry<const bool>& barks()
+{
+    static const Registry<const bool> solid = [] {
+        Registry<const bool> r("bark");
+        r.add("solid", std::make_unique<const bool>(true));
+        r.add("line", std::make_unique<const bool>(false));
+        return r;
+    }();
+    return solid;
+}
+
 }  // namespace
 
 std::vector<std::string> shadowOriginNames() { return shadowOrigins().names(); }
+
+std::vector<std::string> barkNames() { return barks().names(); }
 
 void indexPrimitives(TracedScene& scene)
 {
@@ -253,6 +268,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
     });
     const ShadowOrigin origin =
         chosen("shadow_origin", [&] { return shadowOrigins().get(model.shadowOrigin); });
+    const bool solidBark = chosen("bark", [&] { return barks().get(model.bark); });
     const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
     TracedScene out;
     out.scene = &scene;
@@ -283,6 +299,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
             d.exponent = species.specularExponent;
             d.seed = unsigned(i * 7919u + j * 104729u + scene.trees[i].seed);
             d.tree = int(i);
+            if (solidBark) d.barkRadius_cm = tree.segments[tree.boughs[j].segment].radius_cm;
             boughs.push_back(d);
         }
     }

@@ -59,7 +59,7 @@ vdbtrace::RenderOptions withProgress(tool::Progress& shown)
 // it): --paper first, then each law named.
 struct ModelOverrides {
     bool paper = false;
-    std::string boughLaw, layerModel, extinctionLaw, shadowOrigin;
+    std::string boughLaw, layerModel, extinctionLaw, shadowOrigin, bark;
     double levelBlend = 0.0;  ///< 0: the scene's
 
     void add(CLI::App& cmd)
@@ -67,7 +67,7 @@ struct ModelOverrides {
         cmd.add_flag("--paper", paper,
                      "Every approximation as the paper prints it (render.preset \"paper\"): "
                      "bough law linear, layer model paper, extinction law layer, shadow origin axis, "
-                     "no level blend");
+                     "no level blend, bark line");
         cmd.add_option("--bough-law", boughLaw, "multiscale level 3's law (render.bough_law)")
             ->check(CLI::IsMember(vdbtrace::boughLawNames()));
         cmd.add_option("--layer-model", layerModel,
@@ -86,6 +86,10 @@ struct ModelOverrides {
                        "multiscale: the band about each level threshold over which two levels "
                        "are mixed, as a ratio of q (1: none; render.level_blend)")
             ->check(CLI::Range(1.0, 2.0));
+        cmd.add_option("--bark", bark,
+                       "multiscale: solid (the needles' roots inside the branch are hidden) or "
+                       "line (the branch is the bough's axis, the paper's; render.bark)")
+            ->check(CLI::IsMember(vdbtrace::barkNames()));
     }
     void apply(scenes::ModelChoices& model) const
     {
@@ -95,6 +99,7 @@ struct ModelOverrides {
         if (!extinctionLaw.empty()) model.extinctionLaw = extinctionLaw;
         if (!shadowOrigin.empty()) model.shadowOrigin = shadowOrigin;
         if (levelBlend > 0.0) model.levelBlend = levelBlend;
+        if (!bark.empty()) model.bark = bark;
     }
 };
 

@@ -90,15 +90,18 @@ struct ModelChoices {
     /// Within q in [t / levelBlend, t levelBlend] about each level threshold t a bough is
     /// shaded at both levels and the two mixed (smoothstep in log q); 1: the paper's switch.
     double levelBlend = 1.5;
+    /// The branch a bough's needles grow from: "solid" (a cylinder of the segment's radius,
+    /// inside which the needles' roots are hidden) or "line" (the bough's axis, section 3.1).
+    std::string bark = "solid";
     /// Every choice as the paper prints it (preset "paper"): today's published behaviour.
-    static ModelChoices paper() { return {"linear", "paper", "layer", "axis", 1.0}; }
+    static ModelChoices paper() { return {"linear", "paper", "layer", "axis", 1.0, "line"}; }
     /// The choices that agree with the explicit needles (preset "faithful", the default).
     static ModelChoices faithful() { return {}; }
 };
 
 struct RenderSettings {
     Vec3 background{0.55, 0.7, 0.9};
-    /// preset, then bough_law, layer_model, extinction_law, shadow_origin, level_blend
+    /// preset, then bough_law, layer_model, extinction_law, shadow_origin, level_blend, bark
     ModelChoices model;
     /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
     /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace pine::vdbtrace {
 
@@ -37,9 +38,21 @@ inline bool layeredInterval(const TracedBough& b, const Vec3& o, const Vec3& d, 
     return intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.conesEnd_cm, b.radius_cm, tIn, tOut);
 }
 
+/// Whether x lies inside the bark of bough b's branch: within barkRadius_cm of the axis,
+/// between the base and the tip.
+inline bool insideBark(const TracedBough& b, const Vec3& x)
+{
+    if (!(b.barkRadius_cm > 0.0)) return false;
+    const Vec3 r = x - b.base_cm;
+    const double h = glm::dot(r, b.axis);
+    return h >= 0.0 && h <= b.length_cm &&
+           glm::length(r - h * b.axis) < b.barkRadius_cm;
+}
+
 /// Calls visit(j, t) for every crossing of cone j in [0, floor(length / dh)] by the line
 /// o + t d, t in [tIn, tOut], in order: the march moves g by at most dh / 4 a step (|dg/dt|
 /// <= 1 + cot(phi)) and places each crossing by linear interpolation within its step.
+/// Crossings inside the bark (insideBark) are not visited.
 template <class Visit>
 void forEachConeCrossing(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn,
                          double tOut, Visit&& visit)
@@ -55,7 +68,9 @@ void forEachConeCrossing(const TracedBough& b, const Vec3& o, const Vec3& d, dou
         const long j0 = long(std::floor(g0 / dh)), j1 = long(std::floor(g1 / dh));
         for (long j = std::min(j0, j1) + 1; j <= std::max(j0, j1); ++j) {
             if (j < 0 || j > jMax) continue;
-            visit(j, t0 + (double(j) * dh - g0) / (g1 - g0) * (t1 - t0));
+            const double t = t0 + (double(j) * dh - g0) / (g1 - g0) * (t1 - t0);
+            if (insideBark(b, o + t * d)) continue;  // hidden
+            visit(j, t);
         }
         t0 = t1;
         g0 = g1;
@@ -79,10 +94,12 @@ struct ConeBand {
 /// N / (2 pi rho dh sin(phi)) and their coverage of their cone N r / (pi rho), capped at 1
 /// where they overlap near the apex; its mean over the cone is the paper's A = 2 N r / (pi R).
 /// The same march as forEachConeCrossing; each step's needles are split between the bands it
-/// spans in proportion to g.
+/// spans in proportion to g. Inside the bark (insideBark) the needles' roots are hidden: the
+/// march steps to the bark's surface and counts nothing within it, unless !hiddenInBark (level
+/// 1 looks for whole needles, whose roots the branch's own fragment hides).
 template <class Visit>
 void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn, double tOut,
-                     Visit&& visit)
+                     Visit&& visit, bool hiddenInBark = true)
 {
     const analytic::ConeGeometry& cone = b.geometry.cone;
     const double dh = b.geometry.coneSpacing_cm;
@@ -104,10 +121,20 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
         g = h0 + t * dAlong - rho * cotPhi;
         const double dNeedle =
             rho > 0.0 ? cosPhi * dAlong + sinPhi * glm::dot(d, across) / rho : dAlong;
-        const double coverage = rho > coverageTimesRho ? coverageTimesRho / rho : 1.0;
+            const double coverage = rho > coverageTimesRho ? coverageTimesRho / rho : 1.0;
         sigma = coverage * std::sqrt(std::max(0.0, 1.0 - dNeedle * dNeedle)) * layersPerCm;
     };
     const auto bandOf = [&](double g) { return long(std::floor(g / dh + 0.5)); };
+    // Where the line lies inside the bark: the branch's cylinder of radius barkRadius_cm
+    // from the base to the tip (beyond the tip the last cones' needles are not in it). Its
+    // needles there are hidden; the march steps to the bark's surface, so that each step lies
+    // wholly in or out of it.
+    double barkIn = 0.0, barkOut = 0.0;
+    if (hiddenInBark && b.barkRadius_cm > 0.0 &&
+        !intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.tip_cm, b.barkRadius_cm, barkIn,
+                           barkOut)) {
+        barkIn = barkOut = 0.0;
+    }
 
     double t0 = tIn, g0, s0;
     at(t0, g0, s0);
@@ -125,13 +152,18 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
     };
     int steps = 0;
     while (t0 < tOut && steps++ < 100000) {
-        const double t1 = std::min(t0 + dt, tOut);
+        double t1 = std::min(t0 + dt, tOut);
+        for (const double edge : {barkIn, barkOut}) {
+            if (edge > t0 && edge < t1) t1 = edge;
+        }
         double g1, s1;
         at(t1, g1, s1);
         const int stepDirection = g1 > g0 ? 1 : (g1 < g0 ? -1 : direction);
         if (direction != 0 && stepDirection != direction && !finish()) return;  // g turned
         direction = stepDirection;
-        const double count = 0.5 * (s0 + s1) * (t1 - t0);
+        const double middle = 0.5 * (t0 + t1);
+        const bool inBark = middle > barkIn && middle < barkOut;
+        const double count = inBark ? 0.0 : 0.5 * (s0 + s1) * (t1 - t0);
         double done = 0.0;  // fraction of the step already given to a band
         while (bandOf(g1) != band && direction != 0) {
             const double boundary = (double(band) + 0.5 * direction) * dh;

@@ -67,6 +67,9 @@ struct BoughDescription {
     double exponent = 100.0;
     unsigned seed = 0;  ///< drives the needles' azimuths (needle_layout.h)
     int tree = -1;      ///< index of its tree in the scene's trees
+    /// The radius of the branch the needles grow from, where render.bark is "solid": the
+    /// needles' roots within it lie inside the bark. 0: the branch is the bough's axis.
+    double barkRadius_cm = 0.0;
 };
 
 struct TracedBough {
@@ -81,6 +84,9 @@ struct TracedBough {
     analytic::BoughGeometry geometry;  ///< needle parameters at mid-bough (section 3.1)
     double radius_cm = 0.0;            ///< R = l sin(phi)
     double layerOpacity = 0.0;         ///< A
+    /// Needles within this distance of the axis lie inside the branch's bark: the layer
+    /// models count none of them (render.bark "solid"; 0 for "line", the paper's axis).
+    double barkRadius_cm = 0.0;
     Vec3 needleAlbedo{0.2};
     double specularWeight = 0.0;
     double exponent = 100.0;
@@ -154,6 +160,9 @@ void computeLawProfiles(const TracedScene& scene);
 
 /// The values of render.shadow_origin, the faithful one first.
 std::vector<std::string> shadowOriginNames();
+
+/// The values of render.bark, the faithful one first.
+std::vector<std::string> barkNames();
 
 /// Grows every tree and prepares the scene for its camera under the scene's bough law and
 /// layer model (scene.render.model), in parallel. Keeps a pointer to `scene`, which must
