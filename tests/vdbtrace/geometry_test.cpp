@@ -12,7 +12,6 @@
 #include <cmath>
 #include <random>
 #include <set>
-#include <stdexcept>
 
 namespace pine::vdbtrace {
 namespace {
@@ -105,65 +104,6 @@ TEST(Bvh, FindsEveryBoxTheConeTouches)
             }
         }
     }
-}
-
-// The walk a primary cone takes: the primitives query() finds, each once, in (nearest depth,
-// index) order, so that a composite fed in this order sees what sorting them all would give.
-// Many balls share a centre and radius (equal depths, ordered by index), some are nested
-// (a node's ball is then its primitive's), and the rays start inside the cloud.
-TEST(Bvh, WalksNearestFirstThroughWhatQueryFinds)
-{
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<double> u(-50.0, 50.0), r(0.1, 4.0);
-    std::vector<Aabb> boxes;
-    std::vector<Sphere> spheres;
-    for (int i = 0; i < 3000; ++i) {
-        Vec3 a(u(rng), u(rng), u(rng)), b = a + Vec3(r(rng), -r(rng), r(rng));
-        double radius = 0.1 * r(rng);
-        if (i % 7 == 3) {  // a copy of an earlier primitive: equal nearest depths
-            const std::size_t j = std::size_t(u(rng) + 50.0) % boxes.size();
-            boxes.push_back(boxes[j]);
-            spheres.push_back(spheres[j]);
-            continue;
-        }
-        boxes.push_back(cylinderBounds(a, b, radius));
-        spheres.push_back({0.5 * (a + b), 0.5 * glm::length(b - a) + radius});
-    }
-    const Bvh bvh(boxes, spheres);
-    std::vector<Bvh::Pending> queue;
-    for (int k = 0; k < 300; ++k) {
-        const double z = k % 2 ? -80.0 : u(rng);
-        const ConeRay ray{Vec3(u(rng), u(rng), z),
-                          glm::normalize(Vec3(u(rng) / 50, u(rng) / 50, 1.0)), 0.002 * (k % 5)};
-        const double tMax = k % 3 ? 1e9 : 60.0;
-        std::vector<std::uint32_t> expected;
-        bvh.query(ray, tMax, [&](std::uint32_t i) { expected.push_back(i); });
-        std::sort(expected.begin(), expected.end(), [&](std::uint32_t a, std::uint32_t b) {
-            const double na = nearestDepth(ray, spheres[a]), nb = nearestDepth(ray, spheres[b]);
-            return na < nb || (na == nb && a < b);
-        });
-        std::vector<std::uint32_t> walked;
-        bvh.queryNearestFirst(ray, tMax, queue, [&](double nearest, std::uint32_t i) {
-            EXPECT_EQ(nearest, nearestDepth(ray, spheres[i]));
-            walked.push_back(i);
-            return true;
-        });
-        ASSERT_EQ(walked, expected) << "ray " << k;
-        if (expected.empty()) continue;
-        // Stopped at the n-th primitive, it has visited exactly the first n.
-        const std::size_t n = 1 + expected.size() / 3;
-        walked.clear();
-        bvh.queryNearestFirst(ray, tMax, queue, [&](double, std::uint32_t i) {
-            walked.push_back(i);
-            return walked.size() < n;
-        });
-        EXPECT_EQ(walked, std::vector<std::uint32_t>(expected.begin(), expected.begin() + n));
-    }
-}
-
-TEST(Bvh, RefusesSpheresThatDoNotMatchTheBoxes)
-{
-    EXPECT_THROW(Bvh(std::vector<Aabb>(3), std::vector<Sphere>(2)), std::invalid_argument);
 }
 
 TEST(ConeCamera, FootprintIsOnePixelAtTheCentre)

@@ -4,17 +4,11 @@
 
 #include <algorithm>
 #include <numeric>
-#include <stdexcept>
-#include <utility>
 
 namespace pine::vdbtrace {
 
-Bvh::Bvh(const std::vector<Aabb>& boxes, std::vector<Sphere> spheres)
-    : mSpheres(std::move(spheres))
+Bvh::Bvh(const std::vector<Aabb>& boxes)
 {
-    if (!mSpheres.empty() && mSpheres.size() != boxes.size()) {
-        throw std::invalid_argument("Bvh: one sphere per box, or none");
-    }
     if (boxes.empty()) return;
     mIndices.resize(boxes.size());
     std::iota(mIndices.begin(), mIndices.end(), 0u);
@@ -36,7 +30,6 @@ void Bvh::build(const std::vector<Aabb>& boxes, std::uint32_t node, std::uint32_
     mNodes[node].box = box;
     mNodes[node].centre = box.centre();
     mNodes[node].halfDiagonal = 0.5 * glm::length(box.hi - box.lo);
-    mNodes[node].reach = reachOf(mNodes[node].centre, first, count);
     if (count <= 4) {
         mNodes[node].first = first;
         mNodes[node].count = count;
@@ -57,19 +50,6 @@ void Bvh::build(const std::vector<Aabb>& boxes, std::uint32_t node, std::uint32_
     mNodes[node].count = 0;
     build(boxes, left, first, mid - first);
     build(boxes, left + 1, mid, first + count - mid);
-}
-
-// A node's ball holds its primitives' balls, padded so that rounding never puts its nearest
-// depth beyond theirs.
-double Bvh::reachOf(const Vec3& centre, std::uint32_t first, std::uint32_t count) const
-{
-    if (mSpheres.empty()) return 0.0;
-    double reach = 0.0;
-    for (std::uint32_t i = first; i < first + count; ++i) {
-        const Sphere& s = mSpheres[mIndices[i]];
-        reach = std::max(reach, glm::length(s.centre - centre) + s.radius);
-    }
-    return reach * (1.0 + 1e-12) + 1e-9;
 }
 
 }  // namespace pine::vdbtrace

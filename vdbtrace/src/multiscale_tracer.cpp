@@ -82,7 +82,12 @@ private:
     RenderStats& mStats;
     SurfaceShading mSurfaces;
     std::vector<Fragment> mFragments;
-    std::vector<Bvh::Pending> mQueue;  ///< the BVH's walk, nearest first
+    struct Candidate {
+        double nearest;  ///< no fragment of the primitive lies nearer along the ray
+        std::uint32_t index;  ///< a BVH primitive or kGround
+    };
+    static constexpr std::uint32_t kGround = std::uint32_t(-1);
+    std::vector<Candidate> mCandidates;  ///< the primitives the ray may meet, nearest first
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
     std::vector<NeedleHit> mNeedleHits;               ///< a bough's needles on this ray
@@ -417,19 +422,45 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     mFragments.push_back(rear);
 }
 
+// No fragment of a primitive within `radius` of the segment a-b lies nearer along the ray
+// than this: its fragments lie within radius plus half the footprint of the segment (a level
+// 1 needle's within its cone's reach R plus the needle's radius of it), so within that of
+// its bounding sphere; the footprint's width is bounded at twice the sphere's far side.
+double nearestFragment(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius)
+{
+    const double centre = glm::dot(0.5 * (a + b) - ray.origin, ray.direction);
+    const double reach = 0.5 * glm::length(b - a) + radius;
+    return centre - reach - ray.width(std::max(0.0, centre + reach));
+}
+
 void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
 {
     // Front to back: each primitive's fragments are made (and lit, shadow cones and all) only
     // if the composite is not yet opaque at the nearest depth they can lie at, so that what
-    // lies behind opaque layers costs nothing, not even the BVH's walk to it. A primitive's
-    // fragments lie within its ball (a bough's: its cones' reach R plus the needles' radius
-    // about its axis; a level 1 needle's within that), so no nearer than the ball's nearest
-    // depth. The composite receives the same fragments in the same order as if all were made
-    // and sorted.
+    // lies behind opaque layers costs nothing. The composite receives the same fragments in
+    // the same order as if all were made and sorted.
     double tGround;
     Vec3 normal;
-    bool groundWaits = hitGround(mScene.scene->ground, ray, tGround, normal);
-    const double tMax = groundWaits ? tGround : std::numeric_limits<double>::infinity();
+    const bool hasGround = hitGround(mScene.scene->ground, ray, tGround, normal);
+    const double tMax = hasGround ? tGround : std::numeric_limits<double>::infinity();
+    mCandidates.clear();
+    mScene.bvh.query(ray, tMax, [&](std::uint32_t index) {
+        double nearest;
+        if (mScene.isBranch(index)) {
+            const TracedBranch& br = mScene.branches[index];
+            nearest = nearestFragment(ray, br.base_cm, br.tip_cm, br.radius_cm);
+        } else {
+            const TracedBough& b = mScene.bough(index);
+            nearest = nearestFragment(ray, b.base_cm, b.conesEnd_cm,
+                                      b.radius_cm + b.geometry.cone.needleRadius_cm);
+        }
+        mCandidates.push_back({nearest, index});
+    });
+    if (hasGround) mCandidates.push_back({tGround, kGround});
+    std::sort(mCandidates.begin(), mCandidates.end(),
+              [](const Candidate& x, const Candidate& y) {
+                  return x.nearest < y.nearest || (x.nearest == y.nearest && x.index < y.index);
+              });
     mFragments.clear();
     std::size_t done = 0, sorted = 0;  // of mFragments: composited, and sorted by depth
     // Composites the fragments made so far that lie before `depth`: none made later can.
@@ -444,28 +475,18 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
             composite.add(mFragments[done++]);
         }
     };
-    // The ground comes after every primitive of equal nearest depth.
-    const auto groundBefore = [&](double nearest) {
-        if (!groundWaits || !(tGround < nearest)) return true;
-        groundWaits = false;
-        compositeBefore(tGround);
-        if (composite.opaque()) return false;
-        mFragments.push_back(mSurfaces.groundAt(ray, tGround, normal));
-        return true;
-    };
-    mScene.bvh.queryNearestFirst(ray, tMax, mQueue, [&](double nearest, std::uint32_t index) {
-        if (!groundBefore(nearest)) return false;
-        compositeBefore(nearest);
-        if (composite.opaque()) return false;
-        if (!mScene.isBranch(index)) {
-            addBough(ray, index);
+    for (const Candidate& c : mCandidates) {
+        compositeBefore(c.nearest);
+        if (composite.opaque()) return;
+        if (c.index == kGround) {
+            mFragments.push_back(mSurfaces.groundAt(ray, tGround, normal));
+        } else if (!mScene.isBranch(c.index)) {
+            addBough(ray, c.index);
         } else {
             Fragment f;
-            if (mSurfaces.branch(ray, index, tMax, f)) mFragments.push_back(f);
+            if (mSurfaces.branch(ray, c.index, tMax, f)) mFragments.push_back(f);
         }
-        return true;
-    });
-    if (composite.opaque() || !groundBefore(std::numeric_limits<double>::infinity())) return;
+    }
     compositeBefore(std::numeric_limits<double>::infinity());
 }
 

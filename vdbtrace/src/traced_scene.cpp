@@ -237,18 +237,15 @@ std::vector<std::string> barkNames() { return barks().names(); }
 void indexPrimitives(TracedScene& scene)
 {
     std::vector<Aabb> boxes;
-    std::vector<Sphere> spheres;
     boxes.reserve(scene.branches.size() + scene.boughs.size());
-    spheres.reserve(boxes.capacity());
-    const auto add = [&](const Vec3& a, const Vec3& b, double radius) {
-        boxes.push_back(cylinderBounds(a, b, radius));
-        spheres.push_back({0.5 * (a + b), 0.5 * glm::length(b - a) + radius});
-    };
-    for (const TracedBranch& b : scene.branches) add(b.base_cm, b.tip_cm, b.radius_cm);
-    for (const TracedBough& b : scene.boughs) {
-        add(b.base_cm, b.conesEnd_cm, b.radius_cm + b.geometry.cone.needleRadius_cm);
+    for (const TracedBranch& b : scene.branches) {
+        boxes.push_back(cylinderBounds(b.base_cm, b.tip_cm, b.radius_cm));
     }
-    scene.bvh = Bvh(boxes, std::move(spheres));
+    for (const TracedBough& b : scene.boughs) {
+        boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm,
+                                       b.radius_cm + b.geometry.cone.needleRadius_cm));
+    }
+    scene.bvh = Bvh(boxes);
 }
 
 TracedScene buildTracedScene(const scenes::Scene& scene)

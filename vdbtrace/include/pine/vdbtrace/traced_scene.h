@@ -149,9 +149,9 @@ struct TracedScene {
     }
 };
 
-/// Builds scene.bvh over its branches and boughs (in that order of primitive indices): the
-/// boxes query() culls by and the balls queryNearestFirst orders by, a bough's holding its
-/// cones' reach R and the needles' radius about the axis from the base to the cones' end.
+/// Builds scene.bvh over its branches and boughs (in that order of primitive indices), a
+/// bough's box holding its cones' reach R and the needles' radius about the axis from the base
+/// to the cones' end.
 void indexPrimitives(TracedScene& scene);
 
 /// Computes every bough's law profiles now (view() and each light's opacityFromLight()), in
