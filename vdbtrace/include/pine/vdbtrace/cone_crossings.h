@@ -12,7 +12,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace pine::vdbtrace {
 
@@ -121,7 +120,7 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
         g = h0 + t * dAlong - rho * cotPhi;
         const double dNeedle =
             rho > 0.0 ? cosPhi * dAlong + sinPhi * glm::dot(d, across) / rho : dAlong;
-            const double coverage = rho > coverageTimesRho ? coverageTimesRho / rho : 1.0;
+        const double coverage = rho > coverageTimesRho ? coverageTimesRho / rho : 1.0;
         sigma = coverage * std::sqrt(std::max(0.0, 1.0 - dNeedle * dNeedle)) * layersPerCm;
     };
     const auto bandOf = [&](double g) { return long(std::floor(g / dh + 0.5)); };
