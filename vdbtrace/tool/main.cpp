@@ -480,6 +480,8 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
                   << "\nCPU ratio multiscale / geometry " << ratio << '\n';
         j["geometry"] = describeRun(geo);
         j["geometry"]["samples_per_pixel"] = geometrySamples;
+        j["geometry"]["needle_primitive"] =
+            primitive == vdbtrace::NeedlePrimitive::Curve ? "curve" : "cylinder";
         j["cpu_ratio_multiscale_over_geometry"] = ratio;
     }
     if (scaling) {
