@@ -179,22 +179,23 @@ std::vector<double> mixed(std::vector<double> a, const std::vector<double>& b, d
 }
 
 // Everything the exact law's profiles depend on besides the directions, the length and what a
-// render needs of it.
+// render needs of it, with the bark at one of its knots.
 using Kind =
     std::tuple<double, double, double, double, double, double, double, const LayerModel*>;
-Kind kindOf(const TracedBough& b, const LayerModel& layers)
+Kind kindOf(const TracedBough& b, double bark_cm, const LayerModel& layers)
 {
     const analytic::ConeGeometry& c = b.geometry.cone;
     return {c.aperture_rad, c.needleLength_cm, c.needleRadius_cm, c.needlesPerCone,
-            b.geometry.coneSpacing_cm, b.exponent, b.barkRadius_cm, &layers};
+            b.geometry.coneSpacing_cm, b.exponent, bark_cm, &layers};
 }
 
 // The exact law tabulated for one kind of bough.
 class Tables {
 public:
-    Tables(const BoughLaw& exact, const TracedBough& like, const LayerModel& layers)
-        : mExact(exact), mGeometry(like.geometry), mExponent(like.exponent),
-          mBark_cm(like.barkRadius_cm), mLayers(layers),
+    Tables(const BoughLaw& exact, const TracedBough& like, double bark_cm,
+           const LayerModel& layers)
+        : mExact(exact), mGeometry(like.geometry), mExponent(like.exponent), mBark_cm(bark_cm),
+          mLayers(layers),
           mReach(like.geometry.cone.needleLength_cm * std::cos(like.geometry.cone.aperture_rad)),
           mView({kViewKnots, kCountKnots, kWithinKnots}, 2 * kCells * kAzimuthBins,
                 [this](const auto& i) {
@@ -447,11 +448,9 @@ private:
     // The tables of b's kind with the bark at the knot bark_cm.
     const Tables& tables(const TracedBough& b, const LayerModel& layers, double bark_cm) const
     {
-        TracedBough like = b;
-        like.barkRadius_cm = bark_cm;
         std::lock_guard<std::mutex> lock(mMutex);
-        auto& slot = mTables[kindOf(like, layers)];
-        if (!slot) slot = std::make_unique<Tables>(*mExact, like, layers);
+        auto& slot = mTables[kindOf(b, bark_cm, layers)];
+        if (!slot) slot = std::make_unique<Tables>(*mExact, b, bark_cm, layers);
         return *slot;
     }
 

@@ -479,9 +479,7 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
                   << geo.median.wallSeconds << " (its BVH build included)"
                   << "\nCPU ratio multiscale / geometry " << ratio << '\n';
         j["geometry"] = describeRun(geo);
-        j["geometry"]["samples_per_pixel"] = geometrySamples;
-        j["geometry"]["needle_primitive"] =
-            primitive == vdbtrace::NeedlePrimitive::Curve ? "curve" : "cylinder";
+        j["geometry"].update(vdbtrace::renderMethod("geometry").describe(scene, g));
         j["cpu_ratio_multiscale_over_geometry"] = ratio;
     }
     if (scaling) {
