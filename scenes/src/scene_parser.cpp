@@ -145,14 +145,14 @@ RenderSettings readRender(const Json& value, const Where& where)
     s.model.shadowOrigin = r.string("shadow_origin", s.model.shadowOrigin);
     s.model.bark = r.string("bark", s.model.bark);
     s.needleLevelMax = r.number("needle_level_max", Range::above(0), s.needleLevelMax);
-    s.coneLevelMax = r.number("cone_level_max", Range::above(0), s.coneLevelMax);
-    if (!(s.coneLevelMax > s.needleLevelMax)) {
+    s.model.coneLevelMax = r.number("cone_level_max", Range::above(0), s.model.coneLevelMax);
+    if (!(s.model.coneLevelMax > s.needleLevelMax)) {
         where.key("cone_level_max").fail("must exceed needle_level_max (" +
                                          detail::formatNumber(s.needleLevelMax) + ")");
     }
     // The two bands must not overlap: a bough is mixed from two levels at most. Thresholds
     // closer than the default band allows narrow it.
-    const double widest = std::sqrt(s.coneLevelMax / s.needleLevelMax);
+    const double widest = std::sqrt(s.model.coneLevelMax / s.needleLevelMax);
     s.model.levelBlend = r.number("level_blend", Range::atLeast(1),
                                   std::min(s.model.levelBlend, widest));
     if (s.model.levelBlend > widest) {

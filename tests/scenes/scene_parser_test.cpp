@@ -83,7 +83,7 @@ TEST(SceneParser, MinimalSceneTakesTheHeaderDefaults)
     EXPECT_FALSE(s.effects.specular || s.effects.shadows || s.effects.selfShadowing);
     EXPECT_EQ(s.render.background, render.background);
     EXPECT_EQ(s.render.needleLevelMax, render.needleLevelMax);
-    EXPECT_EQ(s.render.coneLevelMax, render.coneLevelMax);
+    EXPECT_EQ(s.render.model.coneLevelMax, render.model.coneLevelMax);
     EXPECT_TRUE(s.trees.empty());
     EXPECT_TRUE(s.species.empty());
 }
@@ -163,7 +163,7 @@ TEST(SceneParser, RoundTripsEveryValueInMemoryUnits)
                 s.effects.selfShadowing);
     EXPECT_EQ(s.render.background, Vec3(0.1, 0.2, 0.3));
     EXPECT_EQ(s.render.needleLevelMax, 0.5);
-    EXPECT_EQ(s.render.coneLevelMax, 2);
+    EXPECT_EQ(s.render.model.coneLevelMax, 2);
 }
 
 TEST(SceneParser, EffectsListedAreTheOnlyOnesOn)
@@ -201,6 +201,12 @@ TEST(SceneParser, ModelsAreFaithfulUnlessThePresetOrAKeySaysOtherwise)
     const ModelChoices mixed = parseScene(j.dump(), "m.json").render.model;
     EXPECT_EQ(mixed.boughLaw, "linear");
     EXPECT_EQ(mixed.layerModel, "fibre");
+    // The level 3 threshold is one of the choices: the preset's unless the scene names it.
+    EXPECT_EQ(faithful.coneLevelMax, 1.0);
+    EXPECT_EQ(mixed.coneLevelMax, 1.0);
+    j["render"]["cone_level_max"] = 3.0;
+    EXPECT_EQ(parseScene(j.dump(), "m.json").render.model.coneLevelMax, 3.0);
+    j["render"].erase("cone_level_max");
     j["render"]["level_blend"] = 2.5;  // the bands about 0.25 and 1 would overlap past 2
     expectError(j, "render.level_blend", "must be at most sqrt(cone_level_max / needle_level_max) (2)");
     j["render"]["level_blend"] = 0.5;

@@ -130,7 +130,7 @@ TEST(MultiscaleTracer, LevelFollowsTheFootprintAgainstTheConeSpacing)
 {
     scenes::RenderSettings s;
     s.needleLevelMax = 0.25;
-    s.coneLevelMax = 1.0;
+    s.model.coneLevelMax = 1.0;
     EXPECT_EQ(chooseLevel(0.1, 0.9, s), Level::Needle);
     EXPECT_EQ(chooseLevel(0.5, 0.9, s), Level::Cone);
     EXPECT_EQ(chooseLevel(0.9, 0.9, s), Level::Bough);

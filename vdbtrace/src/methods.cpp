@@ -19,7 +19,9 @@ nlohmann::json describeMultiscale(const scenes::Scene& scene, const MethodSettin
             {"layer_model", scene.render.model.layerModel},
             {"shadow_origin", scene.render.model.shadowOrigin},
             {"level_blend", scene.render.model.levelBlend},
-            {"bark", scene.render.model.bark}};
+            {"bark", scene.render.model.bark},
+            {"needle_level_max", scene.render.needleLevelMax},
+            {"cone_level_max", scene.render.model.coneLevelMax}};
 }
 
 RenderResult reference(const TracedScene& scene, const MethodSettings& s,

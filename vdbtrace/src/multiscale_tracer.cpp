@@ -527,10 +527,11 @@ LevelBlend blendLevels(double footprint_cm, double coneSpacing_cm,
     LevelBlend out{level, level, 0.0};
     // Never wider than keeps the two bands apart (a command line's value is not checked
     // against the scene's thresholds).
-    const double band = std::min(s.model.levelBlend, std::sqrt(s.coneLevelMax / s.needleLevelMax));
+    const double coneLevelMax = s.model.coneLevelMax;
+    const double band = std::min(s.model.levelBlend, std::sqrt(coneLevelMax / s.needleLevelMax));
     if (!(band > 1.0)) return out;
     for (const auto& [threshold, lower] :
-         {std::pair{s.needleLevelMax, Level::Needle}, std::pair{s.coneLevelMax, Level::Cone}}) {
+         {std::pair{s.needleLevelMax, Level::Needle}, std::pair{coneLevelMax, Level::Cone}}) {
         const double u = std::log(q / threshold) / std::log(band);  // -1 to 1 across the band
         if (std::abs(u) >= 1.0) continue;
         const double x = 0.5 * (u + 1.0);
@@ -543,7 +544,7 @@ Level chooseLevel(double footprint_cm, double coneSpacing_cm, const scenes::Rend
 {
     const double q = footprint_cm / coneSpacing_cm;
     if (q < s.needleLevelMax) return Level::Needle;
-    if (q < s.coneLevelMax) return Level::Cone;
+    if (q < s.model.coneLevelMax) return Level::Cone;
     return Level::Bough;
 }
 

@@ -60,14 +60,15 @@ vdbtrace::RenderOptions withProgress(tool::Progress& shown)
 struct ModelOverrides {
     bool paper = false;
     std::string boughLaw, layerModel, extinctionLaw, shadowOrigin, bark;
-    double levelBlend = 0.0;  ///< 0: the scene's
+    double levelBlend = 0.0;    ///< 0: the scene's
+    double coneLevelMax = 0.0;  ///< 0: the scene's
 
     void add(CLI::App& cmd)
     {
         cmd.add_flag("--paper", paper,
                      "Every approximation as the paper prints it (render.preset \"paper\"): "
                      "bough law linear, layer model paper, extinction law layer, shadow origin axis, "
-                     "no level blend, bark line");
+                     "no level blend, bark line, level 3 from q = 1");
         cmd.add_option("--bough-law", boughLaw, "multiscale level 3's law (render.bough_law)")
             ->check(CLI::IsMember(vdbtrace::boughLawNames()));
         cmd.add_option("--layer-model", layerModel,
@@ -90,6 +91,10 @@ struct ModelOverrides {
                        "multiscale: solid (the needles' roots inside the branch are hidden) or "
                        "line (the branch is the bough's axis, the paper's; render.bark)")
             ->check(CLI::IsMember(vdbtrace::barkNames()));
+        cmd.add_option("--cone-level-max", coneLevelMax,
+                       "multiscale: level 3 (the bough a volume) from this footprint over cone "
+                       "spacing q on, level 2 below; the paper's 1 (render.cone_level_max)")
+            ->check(CLI::PositiveNumber);
     }
     void apply(scenes::ModelChoices& model) const
     {
@@ -100,6 +105,7 @@ struct ModelOverrides {
         if (!shadowOrigin.empty()) model.shadowOrigin = shadowOrigin;
         if (levelBlend > 0.0) model.levelBlend = levelBlend;
         if (!bark.empty()) model.bark = bark;
+        if (coneLevelMax > 0.0) model.coneLevelMax = coneLevelMax;
     }
 };
 
@@ -117,6 +123,14 @@ std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model,
     auto loaded = std::make_unique<Loaded>();
     loaded->scene = scenes::loadScene(file);
     model.apply(loaded->scene.render.model);
+    const scenes::RenderSettings& render = loaded->scene.render;
+    if (!(render.model.coneLevelMax > render.needleLevelMax)) {
+        std::ostringstream message;
+        message << "cone_level_max " << render.model.coneLevelMax
+                << " (from --cone-level-max or --paper) must exceed the scene's needle_level_max ("
+                << render.needleLevelMax << ")";
+        throw InputError(message.str());
+    }
     if (adjust) adjust(loaded->scene);
     if (check) check(loaded->scene);
     loaded->traced = vdbtrace::buildTracedScene(loaded->scene);
@@ -309,10 +323,6 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         {"pine:threads", tbb::this_task_arena::max_concurrency()},
         {"pine:effects", effects.dump()},
         {"pine:units", "cm"}});
-    if (method.levels) {
-        metadata.emplace_back("pine:needle_level_max", float(s.render.needleLevelMax));
-        metadata.emplace_back("pine:cone_level_max", float(s.render.coneLevelMax));
-    }
     for (const auto& [key, value] : methodSettings.items()) {
         if (value.is_number_integer()) {
             metadata.emplace_back("pine:" + key, value.get<int>());

@@ -93,22 +93,27 @@ struct ModelChoices {
     /// The branch a bough's needles grow from: "solid" (a cylinder of the segment's radius,
     /// inside which the needles' roots are hidden) or "line" (the bough's axis, section 3.1).
     std::string bark = "solid";
+    /// Level 3 (the bough a volume) from q = footprint / dh at least this; level 2 below it
+    /// (down to RenderSettings::needleLevelMax). The paper's 1 for both presets: in a forest
+    /// level 2 agrees with the needles where level 3 does not, but beyond q ~ 1.4 one line a
+    /// pixel through the layers aliases (docs/models.md "Level threshold").
+    double coneLevelMax = 1.0;
     /// Every choice as the paper prints it (preset "paper"): today's published behaviour.
-    static ModelChoices paper() { return {"linear", "paper", "layer", "axis", 1.0, "line"}; }
+    static ModelChoices paper() { return {"linear", "paper", "layer", "axis", 1.0, "line", 1.0}; }
     /// The choices that agree with the explicit needles (preset "faithful", the default).
     static ModelChoices faithful() { return {}; }
 };
 
 struct RenderSettings {
     Vec3 background{0.55, 0.7, 0.9};
-    /// preset, then bough_law, layer_model, extinction_law, shadow_origin, level_blend, bark
+    /// preset, then bough_law, layer_model, extinction_law, shadow_origin, level_blend, bark,
+    /// cone_level_max
     ModelChoices model;
     /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
     /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):
-    /// q < needleLevelMax: level 1, needles resolved; q < coneLevelMax: level 2, each cone a
-    /// semi-opaque surface; otherwise level 3, the bough a volume.
+    /// q < needleLevelMax: level 1, needles resolved; q < model.coneLevelMax: level 2, each
+    /// cone a semi-opaque surface; otherwise level 3, the bough a volume.
     double needleLevelMax = 0.25;
-    double coneLevelMax = 1.0;
 };
 
 struct Scene {
