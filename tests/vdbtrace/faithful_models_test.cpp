@@ -183,9 +183,9 @@ TEST(FaithfulModels, ARecedingBoughNeitherPopsNorFades)
         const double frameWidth_cm = r.image.width * s.pixel_cm;
         coverage *= s.pixel_cm * s.pixel_cm / frameWidth_cm;
         lum *= s.pixel_cm * s.pixel_cm / frameWidth_cm;
-        const int level = q < s.scene.render.needleLevelMax ? 1
+        const int level = q < s.scene.render.needleLevelMax         ? 1
                           : q < s.scene.render.model.coneLevelMax ? 2
-                                                            : 3;
+                                                                  : 3;
         std::printf("q %7.3f  %4dx%-4d  level %d  covered width %.4f cm  luminance %.6f\n", q,
                     r.image.width, r.image.height, level, coverage, lum);
         if (previousCoverage > 0.0) {
