@@ -3,10 +3,12 @@
 #include "pine/support/input_error.h"
 #include "pine/support/progress.h"
 
+#include <malloc.h>
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <new>
 #include <string>
@@ -105,6 +107,24 @@ double peakMemoryMiB()
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     return double(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
+
+bool resetPeakMemory()
+{
+    malloc_trim(0);
+    std::ofstream refs("/proc/self/clear_refs");
+    refs << "5";  // proc(5): "reset the peak resident set size"
+    refs.flush();
+    return bool(refs);
+}
+
+double peakMemoryMiBSinceReset()
+{
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);) {
+        if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;  // kB
+    }
+    return peakMemoryMiB();
 }
 
 double processCpuSeconds()

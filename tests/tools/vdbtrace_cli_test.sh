@@ -245,6 +245,39 @@ expect_error "bench JSON over its scene" 2 "also an input" -- \
 cmp -s "$work/kept.json" "$work/small-firs.json" || fail "bench --json overwrote its scene"
 expect_error "bench even repeats" 2 "odd number" -- bench "$work/small-firs.json" --repeat 2
 
+# bench --grow: each step a scene file as stated, both methods timed at each, the exponents
+# the log-log slopes of what the table says; refusals before any work.
+"$vdbtrace" bench "$work/small-firs.json" --grow resolution --grow-steps 2 --grow-factor 4 \
+    --geometry-samples 1 --grow-dir "$work/grow" --no-plot >"$work/grow.out" 2>"$work/err" \
+    || fail "bench --grow: $(tail -1 "$work/err")"
+/usr/bin/python3 - "$work/grow" "$work/grow.out" <<'PY' || fail "bench --grow: $(cat "$work/grow.out")"
+import csv, json, math, os, sys
+d = sys.argv[1]
+g = json.load(open(os.path.join(d, "growth.json")))
+rows = g["rows"]
+assert [(r["step"], r["method"]) for r in rows] == [
+    (0, "multiscale"), (0, "geometry"), (1, "multiscale"), (1, "geometry")], rows
+for k, size in ((0, [48, 36]), (1, [96, 72])):
+    step = json.load(open(os.path.join(d, "step-%d.json" % k)))
+    assert step["camera"]["resolution"] == size, step["camera"]
+    for r in rows[2 * k:2 * k + 2]:
+        assert r["pixels"] == size[0] * size[1] and r["scale"] == 4 ** k and r["trees"] == 3, r
+        assert r["cpu_seconds"] > 0 and r["peak_memory_mib"] > 0, r
+for m in ("multiscale", "geometry"):
+    a, b = [r for r in rows if r["method"] == m]
+    for key in ("cpu_seconds", "peak_memory_mib"):
+        e = math.log(b[key] / a[key]) / math.log(4)
+        assert math.isclose(g["exponents"][m][key], e, rel_tol=1e-9, abs_tol=1e-12), (m, key)
+assert len(list(csv.DictReader(open(os.path.join(d, "growth.csv"))))) == 4
+assert "multiscale: CPU seconds grow as scale^" in open(sys.argv[2]).read()
+PY
+expect_error "bench --grow without a folder" 2 "grow-dir" -- bench "$work/small-firs.json" --grow resolution
+expect_error "bench --grow, no scatter" 2 "no \"scatter\"" -- \
+    bench "$work/small-firs.json" --grow trees-region --grow-dir "$work/grow-none"
+[ ! -e "$work/grow-none" ] || fail "a refused --grow made its folder"
+expect_error "bench --grow with --json" 2 "does not apply" -- \
+    bench "$work/small-firs.json" --grow resolution --grow-dir "$work/grow2" --json "$work/b.json"
+
 "$vdbtrace" --help >/dev/null || fail "--help"
 # OpenImageIO (some 250 libraries, 0.3 s) loads with the first image, not before every command.
 LD_DEBUG=libs "$vdbtrace" --help 2>"$work/libs" >/dev/null

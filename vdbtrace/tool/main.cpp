@@ -21,6 +21,7 @@
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/preview.h"
 #include "pine/vdbtrace/reference_tracer.h"
+#include "pine/vdbtrace/scene_growth.h"
 #include "pine/vdbtrace/stats_json.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -94,7 +95,7 @@ struct ModelOverrides {
         cmd.add_option("--cone-level-max", coneLevelMax,
                        "multiscale: level 3 (the bough a volume) from this footprint over cone "
                        "spacing q on, level 2 below; the paper's 1 (render.cone_level_max)")
-            ->check(CLI::PositiveNumber);
+            ->check(tool::positiveNumber());
     }
     void apply(scenes::ModelChoices& model) const
     {
@@ -387,6 +388,8 @@ std::string machineDescription();
 struct BenchRun {
     vdbtrace::RenderResult result;
     double wallSeconds = 0.0, cpuSeconds = 0.0, buildSeconds = 0.0;
+    std::size_t trees = 0, boughs = 0;
+    double needles = 0.0;  ///< expected count (cones times needles per cone)
 };
 
 BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
@@ -397,6 +400,9 @@ BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
     const auto built = Clock::now();
     const vdbtrace::TracedScene traced = vdbtrace::buildTracedScene(scene);
     run.buildSeconds = std::chrono::duration<double>(Clock::now() - built).count();
+    run.trees = traced.trees.size();
+    run.boughs = traced.boughs.size();
+    for (const auto& tree : traced.trees) run.needles += tree.counts().needles;
     tool::Progress shown("vdbtrace: " + label);
     const double cpu = tool::processCpuSeconds();
     const auto start = Clock::now();
@@ -537,6 +543,117 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
     std::cout << "peak memory MiB (the process, every run) " << peak << '\n';
     j["peak_memory_mib"] = peak;
     if (!jsonFile.empty()) vdbtrace::writeJsonAtomically(j, jsonFile);
+    return 0;
+}
+
+// `bench --grow`: the scene grown step by step along one axis (scene_growth.h), each step's
+// scene written into `dir` and rendered by each method in this process, its CPU seconds and
+// its own peak of resident memory (reset before each render) recorded; the growth exponents
+// of both fitted over the steps. Writes growth.json and growth.csv, and growth.png through
+// scripts/plot_growth.py unless `plot` is false.
+int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int steps, double factor,
+                const fs::path& dir, const ModelOverrides& model, int geometrySamples,
+                vdbtrace::NeedlePrimitive primitive, int repeats, bool plot)
+{
+    const vdbtrace::GrowthAxis axis = vdbtrace::growthAxis(axisName);
+    (void)scenes::loadScene(sceneFile);  // validates the document the steps are grown from
+    std::ifstream in(sceneFile);
+    const nlohmann::json document = nlohmann::json::parse(in, nullptr, true, true);
+    // Every step grown and read before any work: a step the parser refuses (a scatter that
+    // no longer fits its min_spacing, a resolution over the limit) stops it now.
+    std::vector<nlohmann::json> grown;
+    for (int k = 0; k < steps; ++k) {
+        grown.push_back(vdbtrace::growScene(document, axis, std::pow(factor, k)));
+        const fs::path name = "step-" + std::to_string(k) + ".json";
+        try {
+            (void)scenes::parseScene(grown.back().dump(), name);
+        } catch (const std::exception& e) {
+            std::ostringstream where;
+            where << "--grow " << axisName << ", step " << k << " (x" << std::pow(factor, k)
+                  << "): " << e.what();
+            throw InputError(where.str());
+        }
+    }
+    io::checkWritableFolder(dir);
+    const bool ownPeaks = tool::resetPeakMemory();
+    if (!ownPeaks) {
+        std::cerr << "vdbtrace bench: cannot reset the peak of resident memory here; each "
+                     "step's memory is the process's peak so far\n";
+    }
+    std::vector<std::string> methods = {"multiscale"};
+    if (geometrySamples > 0) methods.push_back("geometry");
+    nlohmann::json rows = nlohmann::json::array();
+    std::vector<double> scale;
+    std::map<std::string, std::vector<double>> cpu, memory;
+    std::cout << "step  scale  trees  boughs  needles  pixels  method  CPU-s  wall-s  peak-MiB\n";
+    for (int k = 0; k < steps; ++k) {
+        const double f = std::pow(factor, k);
+        const fs::path stepFile = dir / ("step-" + std::to_string(k) + ".json");
+        io::writeTextAtomically(stepFile, grown[std::size_t(k)].dump(1) + "\n");
+        scenes::Scene scene = scenes::parseScene(grown[std::size_t(k)].dump(), stepFile);
+        model.apply(scene.render.model);
+        scale.push_back(f);
+        for (const std::string& method : methods) {
+            vdbtrace::MethodSettings settings;
+            settings.geometry.samples = geometrySamples;
+            settings.geometry.primitive = primitive;
+            tool::resetPeakMemory();
+            const BenchSummary b = benchRepeated(
+                scene, method, settings,
+                "step " + std::to_string(k) + " " + method, repeats);
+            const double peak = tool::peakMemoryMiBSinceReset();
+            const BenchRun& r = b.median;
+            cpu[method].push_back(r.cpuSeconds);
+            memory[method].push_back(peak);
+            const long long pixels = (long long)scene.camera.width * scene.camera.height;
+            std::cout << k << "  " << f << "  " << r.trees << "  " << r.boughs << "  "
+                      << std::llround(r.needles) << "  " << pixels << "  " << method << "  "
+                      << r.cpuSeconds << "  " << r.wallSeconds << "  " << peak << std::endl;
+            rows.push_back({{"step", k}, {"scale", f}, {"method", method},
+                            {"scene", stepFile.string()}, {"trees", r.trees},
+                            {"boughs", r.boughs}, {"needles", r.needles}, {"pixels", pixels},
+                            {"cpu_seconds", r.cpuSeconds}, {"cpu_seconds_min", b.cpuMin},
+                            {"cpu_seconds_max", b.cpuMax}, {"wall_seconds", r.wallSeconds},
+                            {"build_seconds", r.buildSeconds}, {"peak_memory_mib", peak}});
+        }
+    }
+    nlohmann::json exponents;
+    for (const std::string& method : methods) {
+        const double e = vdbtrace::growthExponent(scale, cpu[method]);
+        const double m = vdbtrace::growthExponent(scale, memory[method]);
+        exponents[method] = {{"cpu_seconds", e}, {"peak_memory_mib", m}};
+        std::cout << method << ": CPU seconds grow as scale^" << e << ", peak memory as scale^"
+                  << m << '\n';
+    }
+    nlohmann::json j;
+    j["scene"] = sceneFile.string();
+    j["axis"] = axisName;
+    j["factor"] = factor;
+    j["threads"] = tbb::this_task_arena::max_concurrency();
+    j["machine"] = machineDescription();
+    j["repeats"] = repeats;
+    j["memory_per_step"] = ownPeaks;
+    j["model"] = vdbtrace::renderMethod("multiscale")
+                     .describe(scenes::parseScene(document.dump(), sceneFile), {});
+    j["rows"] = rows;
+    j["exponents"] = exponents;
+    vdbtrace::writeJsonAtomically(j, dir / "growth.json");
+    std::ostringstream csv;
+    csv << "step,scale,method,trees,boughs,needles,pixels,cpu_seconds,wall_seconds,"
+           "peak_memory_mib\n";
+    for (const auto& r : rows) {
+        csv << r["step"] << ',' << r["scale"] << ',' << r["method"].get<std::string>() << ','
+            << r["trees"] << ',' << r["boughs"] << ',' << r["needles"] << ',' << r["pixels"]
+            << ',' << r["cpu_seconds"] << ',' << r["wall_seconds"] << ','
+            << r["peak_memory_mib"] << '\n';
+    }
+    io::writeTextAtomically(dir / "growth.csv", csv.str());
+    if (plot && !tool::runPlotScript(tool::plotScript("plot_growth.py"), dir)) {
+        std::cerr << "vdbtrace bench: growth.png not written (python3 with matplotlib "
+                     "missing?); growth.json and growth.csv are\n";
+    }
+    tool::info() << "vdbtrace: growth along " << axisName << " over " << steps
+                 << " steps written to " << dir.string() << '\n';
     return 0;
 }
 
@@ -754,6 +871,29 @@ int main(int argc, char** argv)
             "odd in [1, 15]"))
         ->capture_default_str();
     benchCmd->add_option("--json", benchJson, "Also write every number as JSON");
+    std::string growAxis;
+    int growSteps = 4;
+    double growFactor = 2.0;
+    fs::path growDir;
+    bool growNoPlot = false;
+    benchCmd
+        ->add_option("--grow", growAxis,
+                     "Instead, grow the scene step by step and time both methods at each: "
+                     "trees-region (more trees, same region), trees-density (more trees, "
+                     "larger region), resolution (pixels) or needles (needles per cm of "
+                     "branch); writes the steps' scenes, growth.json, growth.csv and "
+                     "growth.png into --grow-dir")
+        ->check(CLI::IsMember(vdbtrace::growthAxisNames()));
+    benchCmd->add_option("--grow-steps", growSteps, "Steps of --grow, the first the scene as is")
+        ->check(CLI::Range(2, 8))
+        ->capture_default_str();
+    benchCmd
+        ->add_option("--grow-factor", growFactor,
+                     "What each step of --grow multiplies: trees, pixels or needles")
+        ->check(CLI::Range(1.1, 16.0))
+        ->capture_default_str();
+    benchCmd->add_option("--grow-dir", growDir, "Folder for --grow's outputs");
+    benchCmd->add_flag("--no-plot", growNoPlot, "--grow: no growth.png (no python3 needed)");
     model.add(*benchCmd);
 
     fs::path diffA, diffB, diffOut;
@@ -826,6 +966,16 @@ int main(int argc, char** argv)
             }
             vdbtrace::runCompare(compare);
             return 0;
+        }
+        if (!growAxis.empty()) {
+            if (growDir.empty()) throw InputError("--grow needs --grow-dir DIR for its outputs");
+            if (!benchJson.empty() || scaling) {
+                throw InputError(std::string(scaling ? "--scaling" : "--json") +
+                                 " does not apply to --grow (growth.json is written into "
+                                 "--grow-dir)");
+            }
+            return benchGrowth(sceneFile, growAxis, growSteps, growFactor, growDir, model,
+                               benchGeometrySamples, benchPrimitive, benchRepeats, !growNoPlot);
         }
         return bench(sceneFile, scaling, model, benchGeometrySamples, benchPrimitive,
                      benchRepeats, benchJson);

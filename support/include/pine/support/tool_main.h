@@ -28,6 +28,12 @@ CLI::Validator positiveNumber();
 
 /// The process's peak resident memory so far, in MiB (for the tools' summary lines).
 double peakMemoryMiB();
+/// Starts a new peak of resident memory (memory the allocator keeps is given back first), so
+/// that peakMemoryMiBSinceReset() measures one step of a longer run. False where Linux does
+/// not let it (/proc/self/clear_refs): the peak is then the process's.
+bool resetPeakMemory();
+/// The peak resident memory since the last resetPeakMemory() (VmHWM), in MiB.
+double peakMemoryMiBSinceReset();
 /// CPU seconds the process has used so far, all threads (user and system).
 double processCpuSeconds();
 
