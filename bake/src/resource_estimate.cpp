@@ -135,7 +135,7 @@ const ResourceEstimate::Part& ResourceEstimate::largest() const
 }
 
 ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
-                                double voxelSize_cm, double voxelsRead)
+                                double voxelSize_cm, double voxelsRead, bool instanceVariants)
 {
     ResourceEstimate e;
     e.parts.push_back({kProgram, kProgramBytes});
@@ -150,8 +150,15 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
                        trees.branches * kBytesPerBranch +
                            trees.boughs * (kBytesPerBough + kBytesPerBoughLight * lights)});
     if (method == "geometry") {
-        e.parts.push_back({count(trees.needles) + " needle cylinders",
-                           trees.needles * kBytesPerNeedle});
+        std::vector<std::size_t> laidOut;  // the trees whose needles are cylinders of their own
+        for (std::size_t i = 0; i < scene.trees.size(); ++i) {
+            if (!instanceVariants || scene.trees[i].variantOf < 0) laidOut.push_back(i);
+        }
+        const bool copies = laidOut.size() < scene.trees.size();
+        const TreeSample own = copies ? sumTrees(scene, laidOut) : trees;
+        e.parts.push_back({count(own.needles) + " needle cylinders" +
+                               (copies ? " (a variant's trees share them)" : ""),
+                           own.needles * kBytesPerNeedle});
     } else if (method == "reference") {
         if (voxelsRead > 0.0) {
             e.parts.push_back({"light grids", voxelsRead * kBytesPerVoxelLight * lights});

@@ -6,6 +6,7 @@
 
 #include "pine/scenes/tree.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -13,6 +14,7 @@
 #include <numbers>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 namespace pine::scenes::detail {
 namespace {
@@ -121,10 +123,25 @@ public:
         if (const Json* s = r.optional("seed")) {
             seed = static_cast<unsigned>(readInteger(*s, where.key("seed"), 0, kMaxSeed));
         }
+        // Trees drawn from this many variants (height, rotation, seed), each placed as a copy
+        // of the first tree of its variant: instanced by the geometry method, grown once.
+        long long variants = 0;  // 0: every tree its own
+        if (const Json* v = r.optional("variants")) {
+            variants = readInteger(*v, where.key("variants"), 1, std::max(1LL, count));
+        }
         r.finish();
 
         std::mt19937 rng(seed);
         const std::size_t first = out.size();
+        // Variants first, then each tree's position and variant, all from the one generator.
+        std::vector<TreePlacement> drawn(static_cast<std::size_t>(variants));
+        std::vector<long long> firstOf(drawn.size(), -1);
+        for (TreePlacement& v : drawn) {
+            v.species = name;
+            v.height_cm = uniform(rng, hMin, hMax);
+            v.rotation_rad = uniform(rng, 0.0, 2.0 * std::numbers::pi);
+            v.seed = static_cast<unsigned>(rng());
+        }
         for (long long i = 0; i < count; ++i) {
             Vec2 xy;
             for (int attempt = 0;; ++attempt) {
@@ -138,6 +155,19 @@ public:
                 if (farFromOthers(xy, spacing, out, first)) break;
             }
             TreePlacement p;
+            if (variants > 0) {
+                const auto v = std::min(std::size_t(uniform(rng, 0.0, double(variants))),
+                                        drawn.size() - 1);
+                p = drawn[v];
+                if (firstOf[v] < 0) {
+                    firstOf[v] = static_cast<long long>(out.size());
+                } else {
+                    p.variantOf = firstOf[v];
+                }
+                p.base_cm = Vec3(xy, mScene.ground.heightAt(xy.x, xy.y));
+                out.push_back(p);
+                continue;
+            }
             p.species = name;
             p.base_cm = Vec3(xy, mScene.ground.heightAt(xy.x, xy.y));
             p.height_cm = uniform(rng, hMin, hMax);

@@ -246,4 +246,16 @@ Tree growTree(const Species& species, const TreePlacement& placement)
     return tree;
 }
 
+Tree movedBy(const Tree& tree, const Vec3& offset_cm)
+{
+    Tree moved = tree;
+    for (Segment& segment : moved.segments) {
+        segment.base_cm += offset_cm;
+        segment.tip_cm += offset_cm;
+    }
+    moved.boundsMin_cm += offset_cm;
+    moved.boundsMax_cm += offset_cm;
+    return moved;
+}
+
 }  // namespace pine::scenes

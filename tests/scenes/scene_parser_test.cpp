@@ -249,6 +249,43 @@ TEST(SceneParser, ScatterIsSeededInsideItsRegionAndOnTheGround)
     EXPECT_NE(c.trees[2].base_cm, a.trees[2].base_cm);
 }
 
+TEST(SceneParser, ScatterVariantsAreCopiesOfTheirFirstTree)
+{
+    json j = fullScene();
+    const Scene own = parseScene(j.dump(), "own.json");
+    for (const auto& t : own.trees) EXPECT_EQ(t.variantOf, -1);  // without the key: unchanged
+    j["trees"][2]["scatter"]["count"] = 40;
+    j["trees"][2]["scatter"]["min_spacing"] = 20;
+    j["trees"][2]["scatter"]["variants"] = 3;
+    const Scene s = parseScene(j.dump(), "variants.json");
+    ASSERT_EQ(s.trees.size(), 42u);
+    int firsts = 0, copies = 0;
+    for (std::size_t i = 2; i < s.trees.size(); ++i) {
+        const auto& t = s.trees[i];
+        EXPECT_EQ(t.base_cm.z, s.ground.heightAt(t.base_cm.x, t.base_cm.y));
+        if (t.variantOf < 0) {
+            ++firsts;
+            continue;
+        }
+        ++copies;
+        // A copy names an earlier first tree of the same scatter, whose tree it is, elsewhere.
+        ASSERT_GE(t.variantOf, 2);
+        ASSERT_LT(std::size_t(t.variantOf), i);
+        const auto& first = s.trees[std::size_t(t.variantOf)];
+        EXPECT_EQ(first.variantOf, -1);
+        EXPECT_EQ(t.seed, first.seed);
+        EXPECT_EQ(t.height_cm, first.height_cm);
+        EXPECT_EQ(t.rotation_rad, first.rotation_rad);
+        EXPECT_NE(t.base_cm, first.base_cm);
+    }
+    EXPECT_EQ(firsts, 3);  // 40 trees from 3 variants: each drawn (certainly, for this seed)
+    EXPECT_EQ(copies, 37);
+    j["trees"][2]["scatter"]["variants"] = 41;
+    expectError(j, "trees[2].scatter.variants", "40");
+    j["trees"][2]["scatter"]["variants"] = 0;
+    expectError(j, "trees[2].scatter.variants", "1");
+}
+
 TEST(SceneParser, ScatterThatCannotKeepItsSpacingSaysSo)
 {
     json j = fullScene();

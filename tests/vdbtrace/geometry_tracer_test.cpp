@@ -14,6 +14,7 @@
 #include "test_scenes.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
 #include <cmath>
@@ -128,6 +129,86 @@ TEST(GeometryTracer, NativeCurvesAreTheSameCylinders)
     const double rounding = rmse(curve.image, cylinder.image);
     const double sampling = rmse(otherSamples.image, cylinder.image);
     EXPECT_LT(rounding, 0.05 * sampling) << rounding << " against " << sampling;
+}
+
+// Five firs drawn from two variants of a scatter: each variant's needles are laid out once and
+// instanced by Embree at its trees (native curves only).
+std::string variantForest()
+{
+    nlohmann::json j = nlohmann::json::parse(firScene(R"("diffuse", "shadows")", 96, 72));
+    j["trees"] = nlohmann::json::array({{{"scatter",
+                                          {{"species", "fir"},
+                                           {"count", 5},
+                                           {"region", {{-45, 0}, {45, 70}}},
+                                           {"min_spacing", 25},
+                                           {"variants", 2},
+                                           {"seed", 4}}}}});
+    return j.dump();
+}
+
+TEST(GeometryTracer, AVariantsTreesAreItsFirstTreeMoved)
+{
+    const scenes::Scene scene = scenes::parseScene(variantForest(), "variants.json");
+    const TracedScene traced = buildTracedScene(scene);
+    int copies = 0;
+    for (std::size_t i = 0; i < scene.trees.size(); ++i) {
+        const long long p = scene.trees[i].variantOf;
+        if (p < 0) continue;
+        ++copies;
+        const Vec3 offset = scene.trees[i].base_cm - scene.trees[std::size_t(p)].base_cm;
+        ASSERT_GT(glm::length(offset), 20.0);
+        std::vector<const TracedBough*> mine, first;
+        for (const TracedBough& b : traced.boughs) {
+            if (b.tree == int(i)) mine.push_back(&b);
+            if (b.tree == int(p)) first.push_back(&b);
+        }
+        ASSERT_EQ(mine.size(), first.size());
+        ASSERT_FALSE(mine.empty());
+        for (std::size_t k = 0; k < mine.size(); ++k) {
+            EXPECT_EQ(mine[k]->seed, first[k]->seed);  // the same needles ...
+            EXPECT_LT(glm::length(mine[k]->base_cm - (first[k]->base_cm + offset)), 1e-9);
+            EXPECT_LT(glm::length(mine[k]->tip_cm - (first[k]->tip_cm + offset)), 1e-9);
+        }
+    }
+    EXPECT_EQ(copies, 3);  // 5 trees, 2 variants
+}
+
+TEST(GeometryTracer, InstancedVariantsAreTheSameNeedles)
+{
+    // Instanced (curves) against every needle laid out (user cylinders): the same image up to
+    // single-precision rounding, as NativeCurvesAreTheSameCylinders measures it, and the same
+    // trees in the tree AOV.
+    const std::string json = variantForest();
+    GeometryBuild build;
+    const scenes::Scene scene = scenes::parseScene(json, "variants.json");
+    const TracedScene traced = buildTracedScene(scene);
+    GeometryOptions options;
+    options.samples = 4;
+    options.built = [&](const GeometryBuild& b) { build = b; };
+    const RenderResult instanced = renderGeometry(traced, options);
+    EXPECT_EQ(build.variants, 2u);
+    EXPECT_EQ(build.instancedTrees, 5u);
+    EXPECT_EQ(build.needles, 0u);
+    EXPECT_GT(build.variantNeedles, 0u);
+    const RenderResult cylinder = renderJson(json, 4, 0, NeedlePrimitive::Cylinder);
+    const RenderResult otherSamples = renderJson(json, 4, 1, NeedlePrimitive::Cylinder);
+    EXPECT_NEAR(double(instanced.stats.needleHits) / double(cylinder.stats.needleHits), 1.0,
+                1e-3);
+    const double foliage = meanOf(cylinder.image.aovs.at("foliage"), 0, 1);
+    ASSERT_GT(foliage, 0.02);
+    EXPECT_NEAR(meanOf(instanced.image.aovs.at("foliage"), 0, 1) / foliage, 1.0, 2e-3);
+    const double rounding = rmse(instanced.image, cylinder.image);
+    const double sampling = rmse(otherSamples.image, cylinder.image);
+    EXPECT_LT(rounding, 0.05 * sampling) << rounding << " against " << sampling;
+    const std::vector<float>& a = instanced.image.aovs.at("tree");
+    const std::vector<float>& b = cylinder.image.aovs.at("tree");
+    std::size_t same = 0, trees = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        same += a[i] == b[i];
+        trees += b[i] >= 0.0f;
+    }
+    ASSERT_GT(trees, a.size() / 10);
+    EXPECT_GT(double(same), 0.995 * double(a.size()));
 }
 
 TEST(GeometryTracer, ComputesOnlyTheEffectsAskedFor)

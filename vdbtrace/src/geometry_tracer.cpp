@@ -52,6 +52,26 @@ struct CylinderSet {
     unsigned geomID = RTC_INVALID_GEOMETRY_ID;
 };
 
+// A scatter's variant (scenes::TreePlacement::variantOf) whose trees are instanced: its first
+// tree's needles, laid out once, in world coordinates about `origin` (that tree's base).
+struct Variant {
+    CylinderSet needles;
+    Vec3 origin{0.0};
+};
+
+// An instance of a variant's needles at one of its trees.
+struct Placed {
+    std::size_t variant = 0;
+    int tree = -1;
+    Vec3 offset{0.0};  // the tree's base less the variant's origin
+};
+
+struct Instancing {
+    std::vector<Variant> variants;
+    std::vector<Placed> byGeomID;  // indexed by the instance's geometry ID in the scene
+    std::size_t trees = 0;         // trees drawn as instances
+};
+
 // The ray as the sample really is, in double, after Embree's own context (which Embree hands
 // back to the callbacks): the closest hit is found here, not in Embree's float fields.
 struct RayContext {
@@ -60,8 +80,10 @@ struct RayContext {
     double tMin = 0.0, tMax = kInf;
     double t = kInf;  // closest hit so far
     unsigned geomID = RTC_INVALID_GEOMETRY_ID, primID = 0;
+    unsigned instID = RTC_INVALID_GEOMETRY_ID;  // the instance hit, if the hit is instanced
     bool cap = false;
-    unsigned skipGeom = RTC_INVALID_GEOMETRY_ID, skipPrim = 0;  // shadow rays: the surface itself
+    // Shadow rays: the surface itself (in its instance, if any).
+    unsigned skipGeom = RTC_INVALID_GEOMETRY_ID, skipPrim = 0, skipInst = RTC_INVALID_GEOMETRY_ID;
 };
 
 // The ray's interval inside the solid cylinder: the infinite cylinder's chord intersected with
@@ -182,7 +204,8 @@ void curveOccludedFilterFn(const RTCFilterFunctionNArguments* args)
     const auto* ctx = reinterpret_cast<const RayContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] && RTCHitN_geomID(args->hit, args->N, i) == ctx->skipGeom &&
-            RTCHitN_primID(args->hit, args->N, i) == ctx->skipPrim) {
+            RTCHitN_primID(args->hit, args->N, i) == ctx->skipPrim &&
+            RTCHitN_instID(args->hit, args->N, i, 0) == ctx->skipInst) {
             args->valid[i] = 0;
         }
     }
@@ -221,6 +244,7 @@ public:
     ~EmbreeScene()
     {
         if (mScene) rtcReleaseScene(mScene);
+        for (RTCScene child : mChildren) rtcReleaseScene(child);
         if (mDevice) rtcReleaseDevice(mDevice);
     }
     EmbreeScene(const EmbreeScene&) = delete;
@@ -244,34 +268,34 @@ public:
         rtcReleaseGeometry(g);
         check();
     }
-    // Each cylinder a segment of its own: two vertices (x, y, z, r), no flags (no neighbour,
-    // so both ends are capped flat).
-    void attachCurves(CylinderSet& set)
+    void attachCurves(CylinderSet& set) { set.geomID = attachCurvesTo(mScene, set, Vec3(0.0)); }
+
+    /// A scene of its own holding `set` less `origin` (a variant's needles about its first
+    /// tree's base), for instance(): float vertices near 0, whatever the forest's extent.
+    RTCScene prototype(const CylinderSet& set, const Vec3& origin)
     {
-        RTCGeometry g = rtcNewGeometry(mDevice, RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE);
-        const std::size_t n = set.cylinders.size();
-        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-            g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 2 * n));
-        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-            g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned), n));
+        RTCScene child = rtcNewScene(mDevice);
+        mChildren.push_back(child);
+        rtcSetSceneFlags(child, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT);
+        if (!set.cylinders.empty()) attachCurvesTo(child, set, origin);
+        rtcCommitScene(child);
         check();
-        for (std::size_t i = 0; i < n; ++i) {
-            const Cylinder& c = set.cylinders[i];
-            const Vec3 tip = c.base + double(c.length) * Vec3(c.axis);
-            float* v = vertices + 8 * i;
-            for (int k = 0; k < 3; ++k) {
-                v[k] = float(c.base[k]);
-                v[4 + k] = float(tip[k]);
-            }
-            v[3] = v[7] = c.radius;
-            indices[i] = unsigned(2 * i);
-        }
-        rtcSetGeometryOccludedFilterFunction(g, curveOccludedFilterFn);
+        return child;
+    }
+    /// `child` placed with its origin at `at`: the instance's geometry ID in the scene.
+    unsigned instance(RTCScene child, const Vec3& at)
+    {
+        RTCGeometry g = rtcNewGeometry(mDevice, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(g, child);
+        const float xfm[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, float(at.x), float(at.y), float(at.z)};
+        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
         rtcCommitGeometry(g);
-        set.geomID = rtcAttachGeometry(mScene, g);
+        const unsigned id = rtcAttachGeometry(mScene, g);
         rtcReleaseGeometry(g);
         check();
+        return id;
     }
+
     void commit()
     {
         rtcCommitScene(mScene);
@@ -285,9 +309,39 @@ private:
     {
         if (!mError.empty()) throw std::runtime_error("Embree: " + mError);
     }
+    // Each cylinder a segment of its own: two vertices (x, y, z, r), no flags (no neighbour,
+    // so both ends are capped flat); the vertices less `origin`.
+    unsigned attachCurvesTo(RTCScene scene, const CylinderSet& set, const Vec3& origin)
+    {
+        RTCGeometry g = rtcNewGeometry(mDevice, RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE);
+        const std::size_t n = set.cylinders.size();
+        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 2 * n));
+        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned), n));
+        check();
+        for (std::size_t i = 0; i < n; ++i) {
+            const Cylinder& c = set.cylinders[i];
+            const Vec3 tip = c.base + double(c.length) * Vec3(c.axis);
+            float* v = vertices + 8 * i;
+            for (int k = 0; k < 3; ++k) {
+                v[k] = float(c.base[k] - origin[k]);
+                v[4 + k] = float(tip[k] - origin[k]);
+            }
+            v[3] = v[7] = c.radius;
+            indices[i] = unsigned(2 * i);
+        }
+        rtcSetGeometryOccludedFilterFunction(g, curveOccludedFilterFn);
+        rtcCommitGeometry(g);
+        const unsigned id = rtcAttachGeometry(scene, g);
+        rtcReleaseGeometry(g);
+        check();
+        return id;
+    }
 
     RTCDevice mDevice = nullptr;
     RTCScene mScene = nullptr;
+    std::vector<RTCScene> mChildren;  // the variants' needles, instanced
     std::string mError;
     std::atomic<std::int64_t> mBytes{0}, mPeak{0};
 };
@@ -325,9 +379,10 @@ class GeometryRayTracer final : public ShadingMethod::RayTracer {
 public:
     GeometryRayTracer(const TracedScene& scene, const EffectsPlan& plan,
                       const EmbreeScene& embree, const CylinderSet& branches,
-                      const CylinderSet& needles, RenderStats& stats)
+                      const CylinderSet& needles, const Instancing& instancing,
+                      RenderStats& stats)
         : mScene(scene), mPlan(plan), mEmbree(embree), mBranches(branches), mNeedles(needles),
-          mStats(stats), mShadows(plan.shadowRays || plan.selfShadowing)
+          mInstancing(instancing), mStats(stats), mShadows(plan.shadowRays || plan.selfShadowing)
     {
     }
 
@@ -335,20 +390,34 @@ public:
     void trace(const ConeRay& ray, FrontToBack& composite) override;
 
 private:
-    bool occluded(const Vec3& x, const Vec3& towards, double distance, unsigned geomID,
-                  unsigned primID);
+    bool occluded(const Vec3& x, const Vec3& towards, double distance, const RayContext& hit);
+    // The cylinder hit, in world coordinates; `tree` the tree of an instance hit.
+    Cylinder hitCylinder(const RayContext& hit, int& tree) const;
 
     const TracedScene& mScene;
     const EffectsPlan& mPlan;
     const EmbreeScene& mEmbree;
     const CylinderSet& mBranches;
     const CylinderSet& mNeedles;
+    const Instancing& mInstancing;
     RenderStats& mStats;
     bool mShadows;
 };
 
+Cylinder GeometryRayTracer::hitCylinder(const RayContext& hit, int& tree) const
+{
+    if (hit.instID != RTC_INVALID_GEOMETRY_ID) {
+        const Placed& at = mInstancing.byGeomID[hit.instID];
+        Cylinder c = mInstancing.variants[at.variant].needles.cylinders[hit.primID];
+        c.base += at.offset;
+        tree = at.tree;
+        return c;
+    }
+    return (hit.geomID == mNeedles.geomID ? mNeedles : mBranches).cylinders[hit.primID];
+}
+
 bool GeometryRayTracer::occluded(const Vec3& x, const Vec3& towards, double distance,
-                                 unsigned geomID, unsigned primID)
+                                 const RayContext& hit)
 {
     ++mStats.shadowRays;
     RayContext ctx;
@@ -358,8 +427,9 @@ bool GeometryRayTracer::occluded(const Vec3& x, const Vec3& towards, double dist
     ctx.tMin = 0.0;
     ctx.tMax = distance;
     // A convex cylinder never shadows its own lit side: skip it instead of offsetting x.
-    ctx.skipGeom = geomID;
-    ctx.skipPrim = primID;
+    ctx.skipGeom = hit.geomID;
+    ctx.skipPrim = hit.primID;
+    ctx.skipInst = hit.instID;
     RTCRay ray{};
     ray.org_x = float(x.x), ray.org_y = float(x.y), ray.org_z = float(x.z);
     ray.dir_x = float(towards.x), ray.dir_y = float(towards.y), ray.dir_z = float(towards.z);
@@ -396,9 +466,10 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
         // found it if the double ray only grazes it.
         ctx.geomID = rh.hit.geomID;
         ctx.primID = rh.hit.primID;
-        const CylinderSet& set = ctx.geomID == mNeedles.geomID ? mNeedles : mBranches;
+        ctx.instID = rh.hit.instID[0];
+        int tree = -1;
         double tIn, tOut;
-        if (intersectCylinder(ray.origin, ray.direction, set.cylinders[ctx.primID], tIn, tOut,
+        if (intersectCylinder(ray.origin, ray.direction, hitCylinder(ctx, tree), tIn, tOut,
                               ctx.cap) &&
             tIn > 0.0) {
             ctx.t = tIn;
@@ -417,14 +488,15 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     Vec3 N = groundNormal, albedo = mScene.scene->ground.albedo;
     double weight = 0.0, exponent = 1.0;
     int tree = -1;
-    const bool isNeedle = cylinder && ctx.geomID == mNeedles.geomID;
+    const bool instanced = cylinder && ctx.instID != RTC_INVALID_GEOMETRY_ID;
+    const bool isNeedle = cylinder && (instanced || ctx.geomID == mNeedles.geomID);
     if (cylinder) {
-        const CylinderSet& set = isNeedle ? mNeedles : mBranches;
-        const Cylinder& c = set.cylinders[ctx.primID];
+        const Cylinder c = hitCylinder(ctx, tree);
         N = cylinderNormal(c, x, ray.direction, ctx.cap);
         if (isNeedle) {
+            // An instance's bough is its variant's first tree's: the same needles, elsewhere.
             const TracedBough& b = mScene.boughs[c.owner];
-            tree = b.tree;
+            if (!instanced) tree = b.tree;
             albedo = b.needleAlbedo;
             weight = b.specularWeight;
             exponent = b.exponent;
@@ -456,9 +528,7 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
             lobe = cosH > 0.0 ? std::pow(cosH, exponent) : 0.0;
         }
         const bool lit = (mPlan.diffuse && cosL > 0.0) || lobe > 0.0;
-        if (lit && mShadows &&
-            occluded(x, L, distance, cylinder ? ctx.geomID : RTC_INVALID_GEOMETRY_ID,
-                     ctx.primID)) {
+        if (lit && mShadows && occluded(x, L, distance, ctx)) {
             E = Vec3(0.0);
         }
         if (mPlan.diffuse) {
@@ -473,9 +543,37 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     composite.add(f);
 }
 
+// Which trees are drawn as instances of their variant (scenes::TreePlacement::variantOf): with
+// Embree's curves, those of every variant that has copies. Fills `instancing.variants` (their
+// origins; needles laid out by layOut) and returns, per tree, its variant's index or -1.
+std::vector<long long> variantsOf(const TracedScene& scene, NeedlePrimitive primitive,
+                                  Instancing& instancing)
+{
+    const std::vector<scenes::TreePlacement>& trees = scene.scene->trees;
+    std::vector<long long> variant(trees.size(), -1);
+    if (primitive != NeedlePrimitive::Curve || trees.size() != scene.trees.size()) return variant;
+    std::vector<long long> index(trees.size(), -1);  // of a first tree's variant
+    for (std::size_t i = 0; i < trees.size(); ++i) {
+        const long long first = trees[i].variantOf;
+        if (first < 0) continue;
+        auto& v = index[std::size_t(first)];
+        if (v < 0) {
+            v = static_cast<long long>(instancing.variants.size());
+            instancing.variants.emplace_back();
+            instancing.variants.back().origin = trees[std::size_t(first)].base_cm;
+            variant[std::size_t(first)] = v;
+        }
+        variant[i] = v;
+    }
+    for (long long v : variant) instancing.trees += v >= 0;
+    return variant;
+}
+
 // Every needle of every bough (needle_layout.h) and every branch, as cylinders; the box pad
-// covers the float rounding of rays within the scene's extent.
-void layOut(const TracedScene& scene, CylinderSet& branches, CylinderSet& needles)
+// covers the float rounding of rays within the scene's extent. The needles of an instanced
+// tree (`variant` >= 0) go to its variant's set, once, from the variant's first tree.
+void layOut(const TracedScene& scene, const std::vector<long long>& variant,
+            Instancing& instancing, CylinderSet& branches, CylinderSet& needles)
 {
     Aabb box;
     box.grow(scene.scene->camera.position_cm);
@@ -492,8 +590,9 @@ void layOut(const TracedScene& scene, CylinderSet& branches, CylinderSet& needle
                                       float(br.radius_cm), std::uint32_t(i)});
         box.grow(cylinderBounds(br.base_cm, br.tip_cm, br.radius_cm));
     }
-    std::size_t count = 0;
+    std::size_t count = 0;  // of the needles laid out one by one
     for (const TracedBough& b : scene.boughs) {
+        if (b.tree >= 0 && variant[std::size_t(b.tree)] >= 0) continue;
         const NeedleLayout layout(b);
         count += std::size_t(layout.lastCone() + 1) * layout.needlesPerCone();
     }
@@ -502,11 +601,14 @@ void layOut(const TracedScene& scene, CylinderSet& branches, CylinderSet& needle
         const TracedBough& b = scene.boughs[k];
         const NeedleLayout layout(b);
         if (!(layout.length() > 0.0 && layout.radius() > 0.0)) continue;
-        layout.forEach([&](const Vec3& apex, const Vec3& dir) {
-            needles.cylinders.push_back({apex, glm::vec3(dir), float(layout.length()),
-                                         float(layout.radius()), std::uint32_t(k)});
-        });
         box.grow(cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm));
+        const long long v = b.tree >= 0 ? variant[std::size_t(b.tree)] : -1;
+        if (v >= 0 && scene.scene->trees[std::size_t(b.tree)].variantOf >= 0) continue;
+        CylinderSet& set = v >= 0 ? instancing.variants[std::size_t(v)].needles : needles;
+        layout.forEach([&](const Vec3& apex, const Vec3& dir) {
+            set.cylinders.push_back({apex, glm::vec3(dir), float(layout.length()),
+                                     float(layout.radius()), std::uint32_t(k)});
+        });
     }
     // A float ray differs from the double one by ~6e-8 of its coordinates and of the distance
     // travelled, both bounded by the scene's extent: pad by 1e-6 of it, eight times that.
@@ -522,9 +624,22 @@ public:
           mSamples(std::max(1, options.samples)), mSampleSeed(options.sampleSeed),
           mSampleWidth(1.0 / std::sqrt(double(mSamples)))
     {
-        layOut(scene, mBranchSet, mNeedleSet);
+        const std::vector<long long> variant = variantsOf(scene, options.primitive, mInstancing);
+        layOut(scene, variant, mInstancing, mBranchSet, mNeedleSet);
         mEmbree.attach(mBranchSet, options.primitive);
         mEmbree.attach(mNeedleSet, options.primitive);
+        std::vector<RTCScene> prototypes;
+        for (const Variant& v : mInstancing.variants) {
+            prototypes.push_back(mEmbree.prototype(v.needles, v.origin));
+        }
+        const std::vector<scenes::TreePlacement>& trees = scene.scene->trees;
+        for (std::size_t i = 0; i < variant.size(); ++i) {
+            if (variant[i] < 0) continue;
+            const std::size_t v = std::size_t(variant[i]);
+            const unsigned id = mEmbree.instance(prototypes[v], trees[i].base_cm);
+            if (mInstancing.byGeomID.size() <= id) mInstancing.byGeomID.resize(id + 1);
+            mInstancing.byGeomID[id] = {v, int(i), trees[i].base_cm - mInstancing.variants[v].origin};
+        }
         mEmbree.commit();
     }
 
@@ -536,6 +651,12 @@ public:
         b.seconds = seconds;
         b.primitiveBytes = (mNeedleSet.cylinders.capacity() + mBranchSet.cylinders.capacity()) *
                            sizeof(Cylinder);
+        for (const Variant& v : mInstancing.variants) {
+            b.variantNeedles += v.needles.cylinders.size();
+            b.primitiveBytes += v.needles.cylinders.capacity() * sizeof(Cylinder);
+        }
+        b.variants = mInstancing.variants.size();
+        b.instancedTrees = mInstancing.trees;
         b.embreePeakBytes = mEmbree.peakBytes();
         return b;
     }
@@ -556,7 +677,7 @@ public:
     std::unique_ptr<RayTracer> rayTracer(RenderStats& stats) const override
     {
         return std::make_unique<GeometryRayTracer>(mScene, mPlan, mEmbree, mBranchSet,
-                                                   mNeedleSet, stats);
+                                                   mNeedleSet, mInstancing, stats);
     }
 
 private:
@@ -566,6 +687,7 @@ private:
     unsigned mSampleSeed;
     double mSampleWidth;
     CylinderSet mBranchSet, mNeedleSet;
+    Instancing mInstancing;
     EmbreeScene mEmbree;
 };
 

@@ -274,10 +274,18 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
     out.shadowOrigin = origin;
     out.lights = unifiedLights(scene);
     out.trees.resize(scene.trees.size());
+    // A scatter's variant is grown once, at its first tree, and moved to the others' bases.
     tbb::parallel_for(std::size_t(0), scene.trees.size(), [&](std::size_t i) {
         const scenes::TreePlacement& placement = scene.trees[i];
+        if (placement.variantOf >= 0) return;
         out.trees[i] = scenes::growTree(scene.species.at(placement.species), placement);
     });
+    for (std::size_t i = 0; i < scene.trees.size(); ++i) {
+        const long long p = scene.trees[i].variantOf;
+        if (p < 0) continue;
+        out.trees[i] = scenes::movedBy(out.trees[std::size_t(p)],
+                                       scene.trees[i].base_cm - scene.trees[std::size_t(p)].base_cm);
+    }
 
     std::vector<BoughDescription> boughs;
     for (std::size_t i = 0; i < out.trees.size(); ++i) {
@@ -294,7 +302,10 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
             d.spec = specs[j];
             d.specularWeight = species.needleSpecular;
             d.exponent = species.specularExponent;
-            d.seed = unsigned(i * 7919u + j * 104729u + scene.trees[i].seed);
+            // A variant's copies bear its first tree's needles (geometry instances them).
+            const long long variantOf = scene.trees[i].variantOf;
+            const std::size_t first = variantOf < 0 ? i : std::size_t(variantOf);
+            d.seed = unsigned(first * 7919u + j * 104729u + scene.trees[i].seed);
             d.tree = int(i);
             if (solidBark) d.barkRadius_cm = tree.segments[tree.boughs[j].segment].radius_cm;
             boughs.push_back(d);

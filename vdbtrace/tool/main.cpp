@@ -260,7 +260,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             const double voxelsRead =
                 baked ? double(baked->layerOpacity->activeVoxelCount()) : 0.0;
             bake::checkMemory(
-                bake::estimateRender(scene, methodName, settings.voxelSize_cm, voxelsRead),
+                bake::estimateRender(
+                    scene, methodName, settings.voxelSize_cm, voxelsRead,
+                    settings.geometry.primitive == vdbtrace::NeedlePrimitive::Curve),
                 bake::memoryLimit(maxMemoryGiB), sceneFile.string());
         },
         [&](scenes::Scene& scene) {
@@ -294,7 +296,12 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                  << describe(loaded->scene, loaded->traced) << '\n';
     settings.geometry.built = [](const vdbtrace::GeometryBuild& b) {
         tool::info() << "vdbtrace: " << b.needles << " needles and " << b.branches
-                     << " branches as cylinders, BVH built in " << b.seconds << " s ("
+                     << " branches as cylinders";
+        if (b.variants) {
+            tool::info() << ", " << b.variantNeedles << " needles of " << b.variants
+                         << " variants instanced at " << b.instancedTrees << " trees";
+        }
+        tool::info() << ", BVH built in " << b.seconds << " s ("
                      << double(b.primitiveBytes) / (1 << 20) << " MiB of cylinders, Embree peak "
                      << double(b.embreePeakBytes) / (1 << 20) << " MiB)\n";
     };

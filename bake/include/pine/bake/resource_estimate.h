@@ -35,8 +35,11 @@ TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size
 /// the reference's voxels of `voxelSize_cm` with the light reaching each, or with
 /// `voxelsRead` > 0, grids already read, only that light). Each species is grown once, for its
 /// first placement, which stands for all of its placements.
+/// With `instanceVariants` (the geometry method with Embree's curves), the needles of a
+/// scatter's variant count once, whatever the trees that copy it (TreePlacement::variantOf).
 ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
-                                double voxelSize_cm, double voxelsRead = 0.0);
+                                double voxelSize_cm, double voxelsRead = 0.0,
+                                bool instanceVariants = true);
 
 /// The memory `vdbtrace compare` will need: the largest of its methods' renders (the reference
 /// at `smallestVoxel_cm`), with `images` renders kept at once for the report.

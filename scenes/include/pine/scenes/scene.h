@@ -76,6 +76,9 @@ struct TreePlacement {
     double height_cm = 0;  ///< scale the grown tree to this height; 0 keeps the species' own
     double rotation_rad = 0;  ///< about z
     unsigned seed = 1;
+    /// Index (in Scene::trees) of an earlier placement this tree is a copy of, moved to its own
+    /// base: a scatter's "variants" (same species, seed, height and rotation). -1: its own tree.
+    long long variantOf = -1;
 };
 
 /// The model of each approximation the paper makes (docs/models.md), by name: vdbtrace and

@@ -59,6 +59,9 @@ struct Tree {
 /// loadScene rejects the last two, and a height for a species that grows none.
 Tree growTree(const Species& species, const TreePlacement& placement);
 
+/// A copy of `tree` moved by `offset_cm` (a scatter's variant placed at another base).
+Tree movedBy(const Tree& tree, const Vec3& offset_cm);
+
 /// Height of the unscaled tree (highest segment end above its base), in cm. (added)
 double naturalHeight(const Species& species, unsigned seed);
 

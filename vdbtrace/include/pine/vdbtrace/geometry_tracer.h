@@ -16,7 +16,10 @@ namespace pine::vdbtrace {
 
 /// What building the BVH cost (`vdbtrace` prints it).
 struct GeometryBuild {
-    std::size_t needles = 0, branches = 0;
+    std::size_t needles = 0, branches = 0;  ///< cylinders laid out one by one
+    /// Scatter variants (scenes::TreePlacement::variantOf) drawn as Embree instances: their
+    /// needles, laid out once per variant, and the trees that instance them.
+    std::size_t variants = 0, variantNeedles = 0, instancedTrees = 0;
     double seconds = 0.0;               ///< cylinders laid out and the BVH committed
     std::size_t primitiveBytes = 0;     ///< our cylinder records
     std::size_t embreePeakBytes = 0;    ///< Embree's own allocations at their peak (the BVH)
