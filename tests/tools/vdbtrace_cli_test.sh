@@ -275,6 +275,9 @@ expect_error "bench --grow without a folder" 2 "grow-dir" -- bench "$work/small-
 expect_error "bench --grow, no scatter" 2 "no \"scatter\"" -- \
     bench "$work/small-firs.json" --grow trees-region --grow-dir "$work/grow-none"
 [ ! -e "$work/grow-none" ] || fail "a refused --grow made its folder"
+expect_error "bench --grow over --max-memory" 2 "more than --max-memory" -- \
+    bench "$work/small-firs.json" --grow resolution --grow-dir "$work/grow3" --max-memory 0.1
+[ ! -e "$work/grow3" ] || fail "a --grow refused for its memory made its folder"
 expect_error "bench --grow with --json" 2 "does not apply" -- \
     bench "$work/small-firs.json" --grow resolution --grow-dir "$work/grow2" --json "$work/b.json"
 

@@ -560,7 +560,7 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
 // scripts/plot_growth.py unless `plot` is false.
 int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int steps, double factor,
                 const fs::path& dir, const ModelOverrides& model, int geometrySamples,
-                vdbtrace::NeedlePrimitive primitive, int repeats, bool plot)
+                vdbtrace::NeedlePrimitive primitive, int repeats, bool plot, double maxMemoryGiB)
 {
     const vdbtrace::GrowthAxis axis = vdbtrace::growthAxis(axisName);
     (void)scenes::loadScene(sceneFile);  // validates the document the steps are grown from
@@ -573,7 +573,13 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
         grown.push_back(vdbtrace::growScene(document, axis, std::pow(factor, k)));
         const fs::path name = "step-" + std::to_string(k) + ".json";
         try {
-            (void)scenes::parseScene(grown.back().dump(), name);
+            const scenes::Scene step = scenes::parseScene(grown.back().dump(), name);
+            for (const char* method : {"multiscale", "geometry"}) {
+                if (std::string(method) == "geometry" && geometrySamples == 0) continue;
+                bake::checkMemory(bake::estimateRender(step, method, 0.0, 0.0,
+                                                       primitive == vdbtrace::NeedlePrimitive::Curve),
+                                  bake::memoryLimit(maxMemoryGiB), method);
+            }
         } catch (const std::exception& e) {
             std::ostringstream where;
             where << "--grow " << axisName << ", step " << k << " (x" << std::pow(factor, k)
@@ -901,6 +907,7 @@ int main(int argc, char** argv)
         ->capture_default_str();
     benchCmd->add_option("--grow-dir", growDir, "Folder for --grow's outputs");
     benchCmd->add_flag("--no-plot", growNoPlot, "--grow: no growth.png (no python3 needed)");
+    addMaxMemory(*benchCmd, maxMemoryGiB, "a step of --grow");
     model.add(*benchCmd);
 
     fs::path diffA, diffB, diffOut;
@@ -982,7 +989,8 @@ int main(int argc, char** argv)
                                  "--grow-dir)");
             }
             return benchGrowth(sceneFile, growAxis, growSteps, growFactor, growDir, model,
-                               benchGeometrySamples, benchPrimitive, benchRepeats, !growNoPlot);
+                               benchGeometrySamples, benchPrimitive, benchRepeats, !growNoPlot,
+                               maxMemoryGiB);
         }
         return bench(sceneFile, scaling, model, benchGeometrySamples, benchPrimitive,
                      benchRepeats, benchJson);
