@@ -248,7 +248,13 @@ void indexPrimitives(TracedScene& scene)
     scene.bvh = Bvh(boxes);
 }
 
-TracedScene buildTracedScene(const scenes::Scene& scene)
+TracedSceneParts TracedSceneParts::forMethod(const std::string& method)
+{
+    if (method == "geometry") return {false, false};
+    return {};
+}
+
+TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts& parts)
 {
     const scenes::ModelChoices& model = scene.render.model;
     const auto chosen = [&](const char* key, auto&& lookUp) -> decltype(auto) {
@@ -315,9 +321,10 @@ TracedScene buildTracedScene(const scenes::Scene& scene)
     tbb::parallel_for(std::size_t(0), boughs.size(), [&](std::size_t k) {
         out.boughs[k] = makeTracedBough(boughs[k], scene.camera.position_cm, out.lights, *law,
                                        layers, needs);
+        if (!parts.boughLaws) out.boughs[k].law.reset();
     });
 
-    indexPrimitives(out);
+    if (parts.primitiveIndex) indexPrimitives(out);
     return out;
 }
 

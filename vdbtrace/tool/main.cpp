@@ -119,7 +119,8 @@ struct Loaded {
 /// will need), then grown for the tracer.
 std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model,
                              const std::function<void(const scenes::Scene&)>& check = {},
-                             const std::function<void(scenes::Scene&)>& adjust = {})
+                             const std::function<void(scenes::Scene&)>& adjust = {},
+                             const vdbtrace::TracedSceneParts& parts = {})
 {
     auto loaded = std::make_unique<Loaded>();
     loaded->scene = scenes::loadScene(file);
@@ -134,7 +135,7 @@ std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model,
     }
     if (adjust) adjust(loaded->scene);
     if (check) check(loaded->scene);
-    loaded->traced = vdbtrace::buildTracedScene(loaded->scene);
+    loaded->traced = vdbtrace::buildTracedScene(loaded->scene, parts);
     return loaded;
 }
 
@@ -270,7 +271,8 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                 scene.camera.width = frame.width;
                 scene.camera.height = frame.height;
             }
-        });
+        },
+        vdbtrace::TracedSceneParts::forMethod(methodName));
     std::map<int, fs::path> treesRead;  // a tree given twice would be drawn twice
     for (std::size_t i = 0; i < bakedFrom.size(); ++i) {
         checkBakedFrom(gridFiles[i], bakedFrom[i], *loaded, sceneFile);
@@ -405,7 +407,8 @@ BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
     using Clock = std::chrono::steady_clock;
     BenchRun run;
     const auto built = Clock::now();
-    const vdbtrace::TracedScene traced = vdbtrace::buildTracedScene(scene);
+    const vdbtrace::TracedScene traced =
+        vdbtrace::buildTracedScene(scene, vdbtrace::TracedSceneParts::forMethod(method));
     run.buildSeconds = std::chrono::duration<double>(Clock::now() - built).count();
     run.trees = traced.trees.size();
     run.boughs = traced.boughs.size();
