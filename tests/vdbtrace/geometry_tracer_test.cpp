@@ -211,6 +211,25 @@ TEST(GeometryTracer, InstancedVariantsAreTheSameNeedles)
     EXPECT_GT(double(same), 0.995 * double(a.size()));
 }
 
+TEST(GeometryTracer, NeedsNeitherTheConeTracersBvhNorTheBoughLaws)
+{
+    const scenes::Scene scene =
+        scenes::parseScene(firScene(R"("diffuse", "shadows")", 48, 36), "test.json");
+    const TracedScene full = buildTracedScene(scene);
+    const TracedScene lean = buildTracedScene(scene, TracedSceneParts::forMethod("geometry"));
+    EXPECT_FALSE(full.bvh.empty());
+    EXPECT_TRUE(lean.bvh.empty());
+    ASSERT_EQ(lean.boughs.size(), full.boughs.size());
+    EXPECT_THROW((void)lean.boughs.front().view(), std::logic_error);
+    EXPECT_TRUE(TracedSceneParts::forMethod("multiscale").boughLaws);
+    EXPECT_TRUE(TracedSceneParts::forMethod("reference").primitiveIndex);
+    GeometryOptions options;
+    options.samples = 2;
+    const RenderResult a = renderGeometry(full, options), b = renderGeometry(lean, options);
+    EXPECT_EQ(a.image.rgba, b.image.rgba);
+    EXPECT_EQ(a.image.aovs, b.image.aovs);
+}
+
 TEST(GeometryTracer, ComputesOnlyTheEffectsAskedFor)
 {
     const RenderResult plain = renderJson(firScene(R"("diffuse")", 48, 36), 2);
