@@ -286,21 +286,19 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
         if (placement.variantOf >= 0) return;
         out.trees[i] = scenes::growTree(scene.species.at(placement.species), placement);
     });
-    for (std::size_t i = 0; i < scene.trees.size(); ++i) {
+    tbb::parallel_for(std::size_t(0), scene.trees.size(), [&](std::size_t i) {
         const long long p = scene.trees[i].variantOf;
-        if (p < 0) continue;
+        if (p < 0) return;
         out.trees[i] = scenes::movedBy(out.trees[std::size_t(p)],
                                        scene.trees[i].base_cm - scene.trees[std::size_t(p)].base_cm);
-    }
+    });
 
-    std::vector<BoughDescription> boughs;
-    for (std::size_t i = 0; i < out.trees.size(); ++i) {
+    // Each tree's boughs described in parallel, then made in place, tree by tree, in the
+    // trees' order (the primitive indices do not depend on the threads).
+    std::vector<std::vector<BoughDescription>> described(out.trees.size());
+    tbb::parallel_for(std::size_t(0), out.trees.size(), [&](std::size_t i) {
         const scenes::Tree& tree = out.trees[i];
         const scenes::Species& species = *tree.species;
-        for (const scenes::Segment& s : tree.segments) {
-            out.branches.push_back(
-                {s.base_cm, s.tip_cm, s.radius_cm, scenes::barkColour(species), int(i)});
-        }
         const std::vector<bake::BoughSpec> specs = bake::treeBoughs(tree);
         for (std::size_t j = 0; j < specs.size(); ++j) {
             if (!(glm::length(specs[j].tip_cm - specs[j].base_cm) > 0.0)) continue;
@@ -314,14 +312,31 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
             d.seed = unsigned(first * 7919u + j * 104729u + scene.trees[i].seed);
             d.tree = int(i);
             if (solidBark) d.barkRadius_cm = tree.segments[tree.boughs[j].segment].radius_cm;
-            boughs.push_back(d);
+            described[i].push_back(d);
         }
+    });
+    std::vector<std::size_t> firstBough(out.trees.size() + 1, 0);
+    std::vector<std::size_t> firstBranch(out.trees.size() + 1, 0);
+    for (std::size_t i = 0; i < out.trees.size(); ++i) {
+        firstBough[i + 1] = firstBough[i] + described[i].size();
+        firstBranch[i + 1] = firstBranch[i] + out.trees[i].segments.size();
     }
-    out.boughs.resize(boughs.size());
-    tbb::parallel_for(std::size_t(0), boughs.size(), [&](std::size_t k) {
-        out.boughs[k] = makeTracedBough(boughs[k], scene.camera.position_cm, out.lights, *law,
-                                       layers, needs);
-        if (!parts.boughLaws) out.boughs[k].law.reset();
+    out.branches.resize(firstBranch.back());
+    out.boughs.resize(firstBough.back());
+    tbb::parallel_for(std::size_t(0), out.trees.size(), [&](std::size_t i) {
+        const scenes::Tree& tree = out.trees[i];
+        const Vec3 bark = scenes::barkColour(*tree.species);
+        for (std::size_t k = 0; k < tree.segments.size(); ++k) {
+            const scenes::Segment& s = tree.segments[k];
+            out.branches[firstBranch[i] + k] = {s.base_cm, s.tip_cm, s.radius_cm, bark, int(i)};
+        }
+        for (std::size_t k = 0; k < described[i].size(); ++k) {
+            TracedBough& b = out.boughs[firstBough[i] + k];
+            b = makeTracedBough(described[i][k], scene.camera.position_cm, out.lights, *law,
+                                layers, needs);
+            if (!parts.boughLaws) b.law.reset();
+        }
+        std::vector<BoughDescription>().swap(described[i]);
     });
 
     if (parts.primitiveIndex) indexPrimitives(out);
