@@ -271,6 +271,11 @@ for m in ("multiscale", "geometry"):
 assert len(list(csv.DictReader(open(os.path.join(d, "growth.csv"))))) == 4
 assert "multiscale: CPU seconds grow as scale^" in open(sys.argv[2]).read()
 PY
+"$vdbtrace" bench "$work/small-firs.json" --resolution 32x24 --geometry-samples 0 \
+    --json "$work/bench-res.json" >/dev/null 2>"$work/err" || fail "bench --resolution: $(tail -1 "$work/err")"
+/usr/bin/python3 -c 'import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["resolution"] == [32, 24], j["resolution"]' "$work/bench-res.json" || fail "bench --resolution: not 32x24"
 expect_error "bench --grow without a folder" 2 "grow-dir" -- bench "$work/small-firs.json" --grow resolution
 expect_error "bench --grow, no scatter" 2 "no \"scatter\"" -- \
     bench "$work/small-firs.json" --grow trees-region --grow-dir "$work/grow-none"

@@ -448,7 +448,7 @@ BenchSummary benchRepeated(const scenes::Scene& scene, const std::string& method
 
 int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
           int geometrySamples, vdbtrace::NeedlePrimitive primitive, int repeats,
-          const fs::path& jsonFile)
+          const fs::path& jsonFile, int width, int height)
 {
     if (!jsonFile.empty()) {
         io::checkWritable(jsonFile);
@@ -457,6 +457,10 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
     const double startupCpu = tool::processCpuSeconds();
     scenes::Scene scene = scenes::loadScene(sceneFile);
     model.apply(scene.render.model);
+    if (width > 0) {  // --resolution: the same view, its vertical field kept
+        scene.camera.width = width;
+        scene.camera.height = height;
+    }
     vdbtrace::MethodSettings settings;
     const BenchSummary ms = benchRepeated(scene, "multiscale", settings, "multiscale", repeats);
     const vdbtrace::RenderResult& r = ms.median.result;
@@ -563,12 +567,14 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
 // scripts/plot_growth.py unless `plot` is false.
 int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int steps, double factor,
                 const fs::path& dir, const ModelOverrides& model, int geometrySamples,
-                vdbtrace::NeedlePrimitive primitive, int repeats, bool plot, double maxMemoryGiB)
+                vdbtrace::NeedlePrimitive primitive, int repeats, bool plot, double maxMemoryGiB,
+                int width, int height)
 {
     const vdbtrace::GrowthAxis axis = vdbtrace::growthAxis(axisName);
     (void)scenes::loadScene(sceneFile);  // validates the document the steps are grown from
     std::ifstream in(sceneFile);
-    const nlohmann::json document = nlohmann::json::parse(in, nullptr, true, true);
+    nlohmann::json document = nlohmann::json::parse(in, nullptr, true, true);
+    if (width > 0) document["camera"]["resolution"] = {width, height};  // --resolution
     // Every step grown and read before any work: a step the parser refuses (a scatter that
     // no longer fits its min_spacing, a resolution over the limit) stops it now.
     std::vector<nlohmann::json> grown;
@@ -577,10 +583,10 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
         const fs::path name = "step-" + std::to_string(k) + ".json";
         try {
             const scenes::Scene step = scenes::parseScene(grown.back().dump(), name);
+            const bool instanced = primitive == vdbtrace::NeedlePrimitive::Curve;
             for (const char* method : {"multiscale", "geometry"}) {
                 if (std::string(method) == "geometry" && geometrySamples == 0) continue;
-                bake::checkMemory(bake::estimateRender(step, method, 0.0, 0.0,
-                                                       primitive == vdbtrace::NeedlePrimitive::Curve),
+                bake::checkMemory(bake::estimateRender(step, method, 0.0, 0.0, instanced),
                                   bake::memoryLimit(maxMemoryGiB), method);
             }
         } catch (const std::exception& e) {
@@ -649,8 +655,9 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
     j["machine"] = machineDescription();
     j["repeats"] = repeats;
     j["memory_per_step"] = ownPeaks;
-    j["model"] = vdbtrace::renderMethod("multiscale")
-                     .describe(scenes::parseScene(document.dump(), sceneFile), {});
+    scenes::Scene asIs = scenes::parseScene(document.dump(), sceneFile);
+    model.apply(asIs.render.model);
+    j["model"] = vdbtrace::renderMethod("multiscale").describe(asIs, {});
     j["rows"] = rows;
     j["exponents"] = exponents;
     vdbtrace::writeJsonAtomically(j, dir / "growth.json");
@@ -887,6 +894,17 @@ int main(int argc, char** argv)
             "odd in [1, 15]"))
         ->capture_default_str();
     benchCmd->add_option("--json", benchJson, "Also write every number as JSON");
+    std::string benchResolution;
+    benchCmd
+        ->add_option("--resolution", benchResolution,
+                     "WxH instead of the camera's (same view, vertical field kept; with --grow, "
+                     "of the first step)")
+        ->check([](const std::string& text) {
+            int w = 0, h = 0;
+            return vdbtrace::parseResolution(text, w, h)
+                       ? std::string()
+                       : "expected WxH, each at most 16384, e.g. 2560x1920";
+        });
     std::string growAxis;
     int growSteps = 4;
     double growFactor = 2.0;
@@ -984,6 +1002,10 @@ int main(int argc, char** argv)
             vdbtrace::runCompare(compare);
             return 0;
         }
+        int benchWidth = 0, benchHeight = 0;
+        if (!benchResolution.empty()) {
+            vdbtrace::parseResolution(benchResolution, benchWidth, benchHeight);
+        }
         if (!growAxis.empty()) {
             if (growDir.empty()) throw InputError("--grow needs --grow-dir DIR for its outputs");
             if (!benchJson.empty() || scaling) {
@@ -993,9 +1015,9 @@ int main(int argc, char** argv)
             }
             return benchGrowth(sceneFile, growAxis, growSteps, growFactor, growDir, model,
                                benchGeometrySamples, benchPrimitive, benchRepeats, !growNoPlot,
-                               maxMemoryGiB);
+                               maxMemoryGiB, benchWidth, benchHeight);
         }
         return bench(sceneFile, scaling, model, benchGeometrySamples, benchPrimitive,
-                     benchRepeats, benchJson);
+                     benchRepeats, benchJson, benchWidth, benchHeight);
     });
 }
