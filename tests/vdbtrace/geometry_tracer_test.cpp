@@ -5,6 +5,7 @@
 #include "pine/analytic/needle_shader.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/geometry_tracer.h"
+#include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/reference_tracer.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/needle_layout.h"
@@ -216,13 +217,13 @@ TEST(GeometryTracer, NeedsNeitherTheConeTracersBvhNorTheBoughLaws)
     const scenes::Scene scene =
         scenes::parseScene(firScene(R"("diffuse", "shadows")", 48, 36), "test.json");
     const TracedScene full = buildTracedScene(scene);
-    const TracedScene lean = buildTracedScene(scene, TracedSceneParts::forMethod("geometry"));
+    const TracedScene lean = buildTracedScene(scene, renderMethod("geometry").parts);
     EXPECT_FALSE(full.bvh.empty());
     EXPECT_TRUE(lean.bvh.empty());
     ASSERT_EQ(lean.boughs.size(), full.boughs.size());
     EXPECT_THROW((void)lean.boughs.front().view(), std::logic_error);
-    EXPECT_TRUE(TracedSceneParts::forMethod("multiscale").boughLaws);
-    EXPECT_TRUE(TracedSceneParts::forMethod("reference").primitiveIndex);
+    EXPECT_TRUE(renderMethod("multiscale").parts.boughLaws);
+    EXPECT_TRUE(renderMethod("reference").parts.primitiveIndex);
     GeometryOptions options;
     options.samples = 2;
     const RenderResult a = renderGeometry(full, options), b = renderGeometry(lean, options);

@@ -71,12 +71,12 @@ const std::vector<RenderMethod>& renderMethods()
 {
     static const std::vector<RenderMethod> methods = {
         {"multiscale", "closed forms, each hit at the level its footprint calls for",
-         multiscale, describeMultiscale, oneCone, true, true},
+         multiscale, describeMultiscale, oneCone, true, true, TracedSceneParts{}},
         // The reference marches one set of grids merged from every tree.
         {"reference", "equation 7 numerically through OpenVDB grids of the boughs", reference,
-         describeReference, referenceRays, false, false},
+         describeReference, referenceRays, false, false, TracedSceneParts{}},
         {"geometry", "explicit needle cylinders, point samples (the ground truth)", geometry,
-         describeGeometry, geometrySamples, false, true},
+         describeGeometry, geometrySamples, false, true, TracedSceneParts{false, false}},
     };
     return methods;
 }

@@ -248,12 +248,6 @@ void indexPrimitives(TracedScene& scene)
     scene.bvh = Bvh(boxes);
 }
 
-TracedSceneParts TracedSceneParts::forMethod(const std::string& method)
-{
-    if (method == "geometry") return {false, false};
-    return {};
-}
-
 TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts& parts)
 {
     const scenes::ModelChoices& model = scene.render.model;

@@ -272,7 +272,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                 scene.camera.height = frame.height;
             }
         },
-        vdbtrace::TracedSceneParts::forMethod(methodName));
+        vdbtrace::renderMethod(methodName).parts);
     std::map<int, fs::path> treesRead;  // a tree given twice would be drawn twice
     for (std::size_t i = 0; i < bakedFrom.size(); ++i) {
         checkBakedFrom(gridFiles[i], bakedFrom[i], *loaded, sceneFile);
@@ -408,7 +408,7 @@ BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
     BenchRun run;
     const auto built = Clock::now();
     const vdbtrace::TracedScene traced =
-        vdbtrace::buildTracedScene(scene, vdbtrace::TracedSceneParts::forMethod(method));
+        vdbtrace::buildTracedScene(scene, vdbtrace::renderMethod(method).parts);
     run.buildSeconds = std::chrono::duration<double>(Clock::now() - built).count();
     run.trees = traced.trees.size();
     run.boughs = traced.boughs.size();

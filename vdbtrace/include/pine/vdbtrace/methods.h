@@ -38,6 +38,7 @@ struct RenderMethod {
     int (*samplesPerPixel)(const MethodSettings& settings);
     bool levels;   ///< shades at the paper's levels (the "level" AOV means something)
     bool treeIds;  ///< knows which tree each fragment comes from (the "tree" AOV)
+    TracedSceneParts parts;  ///< what it reads of the traced scene (buildTracedScene)
 };
 
 /// Whether `method` computes AOV `aov` (of kAovNames) for a scene with these effects: what an
