@@ -776,6 +776,19 @@ void addMaxMemory(CLI::App& cmd, double& gib, const std::string& task)
         ->check(tool::positiveNumber());
 }
 
+/// --resolution WxH on `cmd`, checked as vdbtrace::parseResolution reads it (`example` in the
+/// message of a refused one).
+void addResolution(CLI::App& cmd, std::string& text, const std::string& help,
+                   const std::string& example)
+{
+    cmd.add_option("--resolution", text, help)->check([example](const std::string& value) {
+        int w = 0, h = 0;
+        return vdbtrace::parseResolution(value, w, h)
+                   ? std::string()
+                   : "expected WxH, each at most 16384, e.g. " + example;
+    });
+}
+
 /// --needle-primitive on `cmd`: what the geometry method's Embree walks.
 void addNeedlePrimitive(CLI::App& cmd, vdbtrace::NeedlePrimitive& primitive)
 {
@@ -836,14 +849,8 @@ int main(int argc, char** argv)
     renderCmd->add_option("--stats", statsFile, "Write render statistics as JSON");
     FrameOverrides frame;
     std::string renderResolution, crop;
-    renderCmd->add_option("--resolution", renderResolution,
-                          "WxH instead of the camera's (same view, vertical field kept)")
-        ->check([](const std::string& text) {
-            int w = 0, h = 0;
-            return vdbtrace::parseResolution(text, w, h)
-                       ? std::string()
-                       : "expected WxH, each at most 16384, e.g. 640x480";
-        });
+    addResolution(*renderCmd, renderResolution,
+                  "WxH instead of the camera's (same view, vertical field kept)", "640x480");
     renderCmd->add_option("--crop", crop,
                           "Only pixels [x0, x1) x [y0, y1) of the frame, as x0,y0,x1,y1 (row 0 "
                           "at the top): the EXR's data window, each pixel as in the whole frame")
@@ -895,16 +902,10 @@ int main(int argc, char** argv)
         ->capture_default_str();
     benchCmd->add_option("--json", benchJson, "Also write every number as JSON");
     std::string benchResolution;
-    benchCmd
-        ->add_option("--resolution", benchResolution,
-                     "WxH instead of the camera's (same view, vertical field kept; with --grow, "
-                     "of the first step)")
-        ->check([](const std::string& text) {
-            int w = 0, h = 0;
-            return vdbtrace::parseResolution(text, w, h)
-                       ? std::string()
-                       : "expected WxH, each at most 16384, e.g. 2560x1920";
-        });
+    addResolution(*benchCmd, benchResolution,
+                  "WxH instead of the camera's (same view, vertical field kept; with --grow, "
+                  "of the first step)",
+                  "2560x1920");
     std::string growAxis;
     int growSteps = 4;
     double growFactor = 2.0;
@@ -955,13 +956,7 @@ int main(int argc, char** argv)
     compareCmd->add_flag("--quick", quick,
                          "Fewer settings (truth 16 spp, geometry 1 and 4 spp, voxels 1 and "
                          "0.5 cm) and an 8-frame dolly at half resolution");
-    compareCmd->add_option("--resolution", resolution, "WxH instead of the camera's (same view)")
-        ->check([](const std::string& text) {
-            int w = 0, h = 0;
-            return vdbtrace::parseResolution(text, w, h)
-                       ? std::string()
-                       : "expected WxH, each at most 16384, e.g. 64x48";
-        });
+    addResolution(*compareCmd, resolution, "WxH instead of the camera's (same view)", "64x48");
     compareCmd->add_flag("--no-plot", noPlot, "Skip error_vs_time.png (matplotlib)");
     addMaxMemory(*compareCmd, maxMemoryGiB, "a comparison");
     model.add(*compareCmd);
