@@ -571,18 +571,22 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
                 int width, int height)
 {
     const vdbtrace::GrowthAxis axis = vdbtrace::growthAxis(axisName);
-    (void)scenes::loadScene(sceneFile);  // validates the document the steps are grown from
+    // Validates the document the steps are grown from; its models describe the run.
+    scenes::Scene asIs = scenes::loadScene(sceneFile);
+    model.apply(asIs.render.model);
     std::ifstream in(sceneFile);
     nlohmann::json document = nlohmann::json::parse(in, nullptr, true, true);
     if (width > 0) document["camera"]["resolution"] = {width, height};  // --resolution
     // Every step grown and read before any work: a step the parser refuses (a scatter that
     // no longer fits its min_spacing, a resolution over the limit) stops it now.
     std::vector<nlohmann::json> grown;
+    std::vector<scenes::Scene> stepScenes;
     for (int k = 0; k < steps; ++k) {
         grown.push_back(vdbtrace::growScene(document, axis, std::pow(factor, k)));
         const fs::path name = "step-" + std::to_string(k) + ".json";
         try {
-            const scenes::Scene step = scenes::parseScene(grown.back().dump(), name);
+            stepScenes.push_back(scenes::parseScene(grown.back().dump(), name));
+            const scenes::Scene& step = stepScenes.back();
             const bool instanced = primitive == vdbtrace::NeedlePrimitive::Curve;
             for (const char* method : {"multiscale", "geometry"}) {
                 if (std::string(method) == "geometry" && geometrySamples == 0) continue;
@@ -612,7 +616,8 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
         const double f = std::pow(factor, k);
         const fs::path stepFile = dir / ("step-" + std::to_string(k) + ".json");
         io::writeTextAtomically(stepFile, grown[std::size_t(k)].dump(1) + "\n");
-        scenes::Scene scene = scenes::parseScene(grown[std::size_t(k)].dump(), stepFile);
+        scenes::Scene& scene = stepScenes[std::size_t(k)];
+        scene.source = stepFile;
         model.apply(scene.render.model);
         scale.push_back(f);
         for (const std::string& method : methods) {
@@ -655,8 +660,6 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
     j["machine"] = machineDescription();
     j["repeats"] = repeats;
     j["memory_per_step"] = ownPeaks;
-    scenes::Scene asIs = scenes::parseScene(document.dump(), sceneFile);
-    model.apply(asIs.render.model);
     j["model"] = vdbtrace::renderMethod("multiscale").describe(asIs, {});
     j["rows"] = rows;
     j["exponents"] = exponents;
