@@ -461,25 +461,27 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     rh.ray.mask = ~0u;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(mEmbree.scene(), &ctx.embree, &rh);
-    if (ctx.geomID == RTC_INVALID_GEOMETRY_ID && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-        // A native curve's hit: where the double ray enters that cylinder, or where Embree
-        // found it if the double ray only grazes it.
+    const bool curve =
+        ctx.geomID == RTC_INVALID_GEOMETRY_ID && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    if (curve) {
         ctx.geomID = rh.hit.geomID;
         ctx.primID = rh.hit.primID;
         ctx.instID = rh.hit.instID[0];
-        int tree = -1;
+    }
+    const bool cylinder = ctx.geomID != RTC_INVALID_GEOMETRY_ID;
+    int tree = -1;  // an instance's; else the hit's own, below
+    const Cylinder c = cylinder ? hitCylinder(ctx, tree) : Cylinder{};
+    if (curve) {
+        // A native curve's hit: where the double ray enters that cylinder, or where Embree
+        // found it if the double ray only grazes it.
         double tIn, tOut;
-        if (intersectCylinder(ray.origin, ray.direction, hitCylinder(ctx, tree), tIn, tOut,
-                              ctx.cap) &&
-            tIn > 0.0) {
+        if (intersectCylinder(ray.origin, ray.direction, c, tIn, tOut, ctx.cap) && tIn > 0.0) {
             ctx.t = tIn;
         } else {
             ctx.t = rh.ray.tfar;
             ctx.cap = false;
         }
     }
-
-    const bool cylinder = ctx.geomID != RTC_INVALID_GEOMETRY_ID;
     if (!cylinder && !std::isfinite(tGround)) return;
     const double t = cylinder ? ctx.t : tGround;
     const Vec3 x = ray.origin + t * ray.direction, V = -ray.direction;
@@ -487,11 +489,9 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     // What the hit is and how it reflects.
     Vec3 N = groundNormal, albedo = mScene.scene->ground.albedo;
     double weight = 0.0, exponent = 1.0;
-    int tree = -1;
     const bool instanced = cylinder && ctx.instID != RTC_INVALID_GEOMETRY_ID;
     const bool isNeedle = cylinder && (instanced || ctx.geomID == mNeedles.geomID);
     if (cylinder) {
-        const Cylinder c = hitCylinder(ctx, tree);
         N = cylinderNormal(c, x, ray.direction, ctx.cap);
         if (isNeedle) {
             // An instance's bough is its variant's first tree's: the same needles, elsewhere.
