@@ -12,7 +12,10 @@ Bvh::Bvh(const std::vector<Aabb>& boxes)
     if (boxes.empty()) return;
     mIndices.resize(boxes.size());
     std::iota(mIndices.begin(), mIndices.end(), 0u);
-    mNodes.reserve(2 * boxes.size());
+    // A node of more than 4 splits into halves of at least 2, so there are at most N / 2
+    // leaves and N - 1 nodes: reserving 2 N kept half the nodes' memory idle (a landscape's
+    // 3.5 million primitives, about 300 MB).
+    mNodes.reserve(boxes.size());
     mNodes.emplace_back();
     build(boxes, 0, 0, std::uint32_t(boxes.size()));
 }
