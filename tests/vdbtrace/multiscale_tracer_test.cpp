@@ -5,6 +5,7 @@
 #include "pine/analytic/cone_shader.h"
 #include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/layer_model.h"
+#include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -74,6 +75,43 @@ TEST(MultiscaleTracer, ImageIsTheSameWhateverTheThreadCount)
     EXPECT_EQ(one.image.aovs, two.image.aovs);
     EXPECT_EQ(one.stats.shadowRays, two.stats.shadowRays);
     EXPECT_EQ(one.stats.diffuseEvaluations, two.stats.diffuseEvaluations);
+}
+
+TEST(MultiscaleTracer, ItsLeanTracedSceneRendersTheSameImage)
+{
+    // The method's parts release the grown trees (keeping their counts), and a bough's view
+    // keeps only the profiles the scene's effects read: the same image, and each dropped
+    // profile is 0 where the full effects keep a sampled one.
+    const scenes::Scene scene =
+        scenes::parseScene(firScene(R"("diffuse", "shadows")", 48, 36), "test.json");
+    const TracedScene full = buildTracedScene(scene);
+    const TracedScene lean = buildTracedScene(scene, renderMethod("multiscale").parts);
+    ASSERT_FALSE(full.trees.empty());
+    EXPECT_TRUE(lean.trees.empty());
+    ASSERT_EQ(lean.treeCounts.size(), full.trees.size());
+    for (std::size_t i = 0; i < full.trees.size(); ++i) {
+        EXPECT_EQ(lean.treeCounts[i].needles, full.trees[i].counts().needles);
+        EXPECT_EQ(lean.treeCounts[i].branches, full.trees[i].counts().branches);
+    }
+    const RenderResult a = renderMultiscale(full, {}), b = renderMultiscale(lean, {});
+    EXPECT_EQ(a.image.rgba, b.image.rgba);
+    EXPECT_EQ(a.image.aovs, b.image.aovs);
+    EXPECT_GT(b.stats.boughHits, 0u);
+
+    const scenes::Scene every = scenes::parseScene(
+        firScene(R"("diffuse", "specular", "shadows", "self_shadowing")", 48, 36), "test.json");
+    const TracedScene all = buildTracedScene(every, renderMethod("multiscale").parts);
+    const BoughLighting& kept = all.boughs.front().view().lighting.at(0);
+    const BoughLighting& dropped = lean.boughs.front().view().lighting.at(0);
+    EXPECT_FALSE(kept.diffuse.front.isConstant());
+    EXPECT_FALSE(kept.specular.front.isConstant());
+    EXPECT_FALSE(kept.transfer.front.isConstant());
+    EXPECT_FALSE(dropped.diffuse.front.isConstant());
+    for (const StripProfile* p : {&dropped.specular.front, &dropped.specular.rear,
+                                  &dropped.transfer.front, &dropped.transfer.rear}) {
+        EXPECT_TRUE(p->isConstant());
+        EXPECT_EQ(p->mean(), 0.0);
+    }
 }
 
 TEST(MultiscaleTracer, SwitchedOffShadowsCastNoShadowRay)

@@ -17,6 +17,7 @@
 #include <limits>
 #include <mutex>
 #include <stdexcept>
+#include <utility>
 
 namespace pine::vdbtrace {
 namespace {
@@ -83,16 +84,27 @@ Vec3 stripAcross(const Vec3& axis, const Vec3& towards)
     return n > 1e-9 ? c / n : analytic::anyPerpendicular(axis);
 }
 
-struct BoughLawEvaluation {
+// What every bough of a scene evaluates its law with: one, shared, for all of them.
+struct BoughLawContext {
     const BoughLaw* law = nullptr;
     const LayerModel* layers = nullptr;
     BoughLawNeeds needs;
-    Vec3 V{0.0};                ///< unit, from the bough's centre to the camera
-    std::vector<Vec3> towards;  ///< unit, from the bough's centre to each light
+    Vec3 eye_cm{0.0};
+    std::vector<Light> lights;
+};
+
+// A bough's own: its profiles once computed. The directions they are computed for are derived
+// again from the bough and the context, not kept: a landscape has 3.3 million boughs, of which
+// only those a cone meets at level 3 ever compute a view.
+struct BoughLawEvaluation {
+    std::shared_ptr<const BoughLawContext> context;
     std::once_flag viewOnce;
-    BoughView view;
-    std::unique_ptr<std::once_flag[]> fromLightOnce;  ///< one per light
-    std::vector<StripProfile> fromLight;
+    std::unique_ptr<const BoughView> view;
+    struct FromLight {
+        std::once_flag once;
+        StripProfile profile;
+    };
+    std::unique_ptr<FromLight[]> fromLight;  ///< one per light
 };
 
 namespace {
@@ -104,53 +116,76 @@ BoughLawEvaluation& evaluation(const std::shared_ptr<BoughLawEvaluation>& law)
     return *law;
 }
 
+// A bough's law sees the camera (V) and each light (L) from its centre.
+Vec3 boughCentre(const TracedBough& b) { return 0.5 * (b.base_cm + b.tip_cm); }
+
+Vec3 towardsLight(const Light& light, const Vec3& centre)
+{
+    Vec3 L, irradiance;
+    double distance;
+    light.at(centre, L, distance, irradiance);
+    return L;
+}
+
 }  // namespace
 
 const BoughView& TracedBough::view() const
 {
     BoughLawEvaluation& e = evaluation(law);
     std::call_once(e.viewOnce, [&] {
-        const BoughShading shading = e.law->shade(*this, e.V, e.towards, *e.layers, e.needs);
-        if (shading.lights.size() != e.towards.size()) {
+        const BoughLawContext& c = *e.context;
+        const Vec3 centre = boughCentre(*this);
+        const Vec3 V = glm::normalize(c.eye_cm - centre);
+        std::vector<Vec3> towards;
+        for (const Light& light : c.lights) towards.push_back(towardsLight(light, centre));
+        BoughShading shading = c.law->shade(*this, V, towards, *c.layers, c.needs);
+        if (shading.lights.size() != towards.size()) {
             throw std::logic_error("a bough law shaded another number of lights");
         }
-        BoughView view;
-        view.alpha = shading.alpha;
+        auto view = std::make_unique<BoughView>();
+        view->alpha = std::move(shading.alpha);
         const analytic::ConeGeometry& cone = geometry.cone;
-        for (std::size_t i = 0; i < e.towards.size(); ++i) {
+        for (std::size_t i = 0; i < towards.size(); ++i) {
             BoughLighting lit;
             // A law that shades the needles does not read the faces' mean I^cyl.
             if (!shadesNeedles) {
                 const auto sums = analytic::coneSums(
                     cone,
-                    analytic::coneIntegrals(cone.aperture_rad, axis, e.towards[i], e.V, exponent),
+                    analytic::coneIntegrals(cone.aperture_rad, axis, towards[i], V, exponent),
                     exponent);
                 lit.front = analytic::meanReflectance(sums.front);
                 lit.rear = analytic::meanReflectance(sums.rear);
             }
-            lit.transfer = shading.lights[i].transfer;
-            lit.diffuse = shading.lights[i].diffuse;
-            lit.specular = shading.lights[i].specular;
-            view.lighting.push_back(lit);
+            // What the render's effects do not read is not kept (half a landscape's views).
+            BoughLightTransfer& shaded = shading.lights[i];
+            if (c.needs.transfer) lit.transfer = std::move(shaded.transfer);
+            if (c.needs.diffuse) lit.diffuse = std::move(shaded.diffuse);
+            if (c.needs.specular) lit.specular = std::move(shaded.specular);
+            view->lighting.push_back(lit);
         }
         e.view = std::move(view);  // only whole: a throw leaves the flag unset to try again
     });
-    return e.view;
+    return *e.view;
 }
 
 const StripProfile& TracedBough::opacityFromLight(std::size_t light) const
 {
     BoughLawEvaluation& e = evaluation(law);
-    std::call_once(e.fromLightOnce[light], [&] {
-        e.fromLight[light] = e.law->opacityFromLight(*this, e.towards[light], *e.layers);
+    BoughLawEvaluation::FromLight& slot = e.fromLight[light];
+    std::call_once(slot.once, [&] {
+        const BoughLawContext& c = *e.context;
+        slot.profile = c.law->opacityFromLight(
+            *this, towardsLight(c.lights[light], boughCentre(*this)), *c.layers);
     });
-    return e.fromLight[light];
+    return slot.profile;
 }
 
-TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
-                            const std::vector<Light>& lights, const BoughLaw& law,
-                            const LayerModel& layers, const BoughLawNeeds& needs)
+namespace {
+
+TracedBough makeTracedBough(const BoughDescription& d,
+                            const std::shared_ptr<const BoughLawContext>& context)
 {
+    const BoughLaw& law = *context->law;
     TracedBough b;
     b.base_cm = d.spec.base_cm;
     b.tip_cm = d.spec.tip_cm;
@@ -173,24 +208,35 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
     b.stripEnd_cm = traits.stripToConesEnd ? b.conesEnd_cm : b.tip_cm;
     b.shadesNeedles = traits.shadesNeedles;
 
-    // Directions from the bough's centre: to the camera (V) and to each light (L).
     auto e = std::make_shared<BoughLawEvaluation>();
-    e->law = &law;
-    e->layers = &layers;
-    e->needs = needs;
-    const Vec3 centre = 0.5 * (b.base_cm + b.tip_cm);
-    e->V = glm::normalize(eye_cm - centre);
-    for (const Light& light : lights) {
-        Vec3 L, irradiance;
-        double distance;
-        light.at(centre, L, distance, irradiance);
-        e->towards.push_back(L);
-    }
-    e->fromLightOnce = std::make_unique<std::once_flag[]>(lights.size());
-    e->fromLight.resize(lights.size());
-    b.across = stripAcross(b.axis, e->V);
+    e->context = context;
+    e->fromLight = std::make_unique<BoughLawEvaluation::FromLight[]>(context->lights.size());
+    b.across = stripAcross(b.axis, glm::normalize(context->eye_cm - boughCentre(b)));
     b.law = std::move(e);
     return b;
+}
+
+std::shared_ptr<const BoughLawContext> lawContext(const Vec3& eye_cm,
+                                                  const std::vector<Light>& lights,
+                                                  const BoughLaw& law, const LayerModel& layers,
+                                                  const BoughLawNeeds& needs)
+{
+    auto c = std::make_shared<BoughLawContext>();
+    c->law = &law;
+    c->layers = &layers;
+    c->needs = needs;
+    c->eye_cm = eye_cm;
+    c->lights = lights;
+    return c;
+}
+
+}  // namespace
+
+TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
+                            const std::vector<Light>& lights, const BoughLaw& law,
+                            const LayerModel& layers, const BoughLawNeeds& needs)
+{
+    return makeTracedBough(d, lawContext(eye_cm, lights, law, layers, needs));
 }
 
 void computeLawProfiles(const TracedScene& scene)
@@ -317,6 +363,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     }
     out.branches.resize(firstBranch.back());
     out.boughs.resize(firstBough.back());
+    const auto context = lawContext(scene.camera.position_cm, out.lights, *law, layers, needs);
     tbb::parallel_for(std::size_t(0), out.trees.size(), [&](std::size_t i) {
         const scenes::Tree& tree = out.trees[i];
         const Vec3 bark = scenes::barkColour(*tree.species);
@@ -326,13 +373,15 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
         }
         for (std::size_t k = 0; k < described[i].size(); ++k) {
             TracedBough& b = out.boughs[firstBough[i] + k];
-            b = makeTracedBough(described[i][k], scene.camera.position_cm, out.lights, *law,
-                                layers, needs);
+            b = makeTracedBough(described[i][k], context);
             if (!parts.boughLaws) b.law.reset();
         }
         std::vector<BoughDescription>().swap(described[i]);
     });
 
+    out.treeCounts.reserve(out.trees.size());
+    for (const scenes::Tree& tree : out.trees) out.treeCounts.push_back(tree.counts());
+    if (!parts.grownTrees) std::vector<scenes::Tree>().swap(out.trees);
     if (parts.primitiveIndex) indexPrimitives(out);
     return out;
 }

@@ -142,9 +142,9 @@ std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model,
 std::string describe(const scenes::Scene& scene, const vdbtrace::TracedScene& traced)
 {
     double needles = 0.0, branches = 0.0;
-    for (const auto& tree : traced.trees) {
-        needles += tree.counts().needles;
-        branches += double(tree.counts().branches);
+    for (const scenes::TreeCounts& counts : traced.treeCounts) {
+        needles += counts.needles;
+        branches += double(counts.branches);
     }
     // Needle counts are expected values (cones times needles per cone, which may vary along a
     // bough): shown whole, as counts.
@@ -285,9 +285,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                              "'");
         }
     }
-    if (!treesRead.empty() && treesRead.size() < loaded->traced.trees.size()) {
+    if (!treesRead.empty() && treesRead.size() < loaded->traced.treeCounts.size()) {
         std::cerr << "vdbtrace: warning: --grids holds " << treesRead.size() << " of the "
-                  << loaded->traced.trees.size() << " trees of '" << sceneFile.string()
+                  << loaded->traced.treeCounts.size() << " trees of '" << sceneFile.string()
                   << "': the others render without foliage\n";
     }
     if (baked) {
@@ -410,9 +410,9 @@ BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
     const vdbtrace::TracedScene traced =
         vdbtrace::buildTracedScene(scene, vdbtrace::renderMethod(method).parts);
     run.buildSeconds = std::chrono::duration<double>(Clock::now() - built).count();
-    run.trees = traced.trees.size();
+    run.trees = traced.treeCounts.size();
     run.boughs = traced.boughs.size();
-    for (const auto& tree : traced.trees) run.needles += tree.counts().needles;
+    for (const scenes::TreeCounts& counts : traced.treeCounts) run.needles += counts.needles;
     tool::Progress shown("vdbtrace: " + label);
     const double cpu = tool::processCpuSeconds();
     const auto start = Clock::now();

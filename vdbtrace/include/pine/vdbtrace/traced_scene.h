@@ -49,6 +49,7 @@ struct BoughLighting {
     analytic::FaceReflectance front, rear;
     FrontRearProfile transfer;              ///< the bough law's, with self-shadowing
     FrontRearProfile diffuse, specular;     ///< the law's, where it shades needles
+    // Each profile is kept only where the scene's effects read it (BoughLawNeeds), else 0.
 };
 
 /// What level 3 draws of a bough seen from the camera, under the bough law.
@@ -130,7 +131,8 @@ enum class ShadowOrigin {
 
 struct TracedScene {
     const scenes::Scene* scene = nullptr;
-    std::vector<scenes::Tree> trees;
+    std::vector<scenes::Tree> trees;  ///< empty unless TracedSceneParts::grownTrees
+    std::vector<scenes::TreeCounts> treeCounts;  ///< one per tree of the scene, always
     std::vector<Light> lights;
     std::vector<TracedBranch> branches;  ///< primitive index i < branches.size()
     std::vector<TracedBough> boughs;     ///< primitive index branches.size() + j
@@ -171,6 +173,10 @@ std::vector<std::string> barkNames();
 struct TracedSceneParts {
     bool primitiveIndex = true;  ///< TracedScene::bvh (else empty)
     bool boughLaws = true;       ///< each bough's law evaluation (else view() throws)
+    /// TracedScene::trees, the grown trees the boughs and branches were made from (else
+    /// released after the build; treeCounts stays): the multiscale method reads only its
+    /// boughs and branches, and a landscape's 10,000 trees take about 500 MB.
+    bool grownTrees = true;
 };
 
 /// Grows every tree and prepares the scene for its camera under the scene's bough law and
