@@ -44,12 +44,13 @@ struct TracedBranch {
 };
 
 /// What a bough looks like from one light with the camera where it is (section 6 inputs).
+/// A bough's view keeps each profile only where the scene's effects read it (BoughLawNeeds);
+/// the others are 0.
 struct BoughLighting {
     /// I^cyl of each face (diffuse, specular); zero for a law that shades needles.
     analytic::FaceReflectance front, rear;
     FrontRearProfile transfer;              ///< the bough law's, with self-shadowing
     FrontRearProfile diffuse, specular;     ///< the law's, where it shades needles
-    // Each profile is kept only where the scene's effects read it (BoughLawNeeds), else 0.
 };
 
 /// What level 3 draws of a bough seen from the camera, under the bough law.
