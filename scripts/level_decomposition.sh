@@ -17,7 +17,7 @@
 #
 #   bash scripts/level_decomposition.sh [DIR]     renders into DIR (default: a temporary folder)
 #
-# Takes about ten minutes on 2 cores. Uses build/bin (build first) and oiiotool.
+# Takes about seven minutes on 2 cores. Uses build/bin (build first) and oiiotool.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${VDBTRACE:-build/bin/vdbtrace}
