@@ -73,6 +73,17 @@ private:
     // footprint, a disc across the camera ray, spreads the lines across an occluder only as
     // far as it spreads across that occluder's strip (ShadowSamples::footprintNormal).
     double shadowOf(const ConeRay& ray, std::size_t index, std::size_t light, double tRef);
+    // Level 3's: the light each half of the bough reflects lies across the footprint's share
+    // of its strip as the law's profile `reflects` says (most of it along the lit edge of a
+    // self-shadowed bough), along the chord [tIn, tOut]. The share is cut into kShadowStrips
+    // strips across, each three points per half weighted by what it reflects, each reading the
+    // occluders over its own width: one line read over the whole footprint multiplies the
+    // occluders' means and samples the strip's middle, where the branch is, not the lit edge.
+    // `behind` is the opacity the rear half's light lies behind where the law's rear profile
+    // does not already hold it (RearComposite::Own: the front's), else null.
+    double shadowAcross(const ConeRay& ray, std::size_t index, std::size_t light,
+                        const FrontRearProfile& reflects, const StripProfile* behind, double xi,
+                        double w, double tIn, double tMid, double tOut);
 
     const TracedScene& mScene;
     const EffectsPlan& mPlan;
@@ -116,6 +127,51 @@ double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std:
     }
     mShadowSamples.footprintNormal = ray.direction;
     return mSurfaces.shadow(light, ray.origin + tRef * ray.direction, ray.width(tRef), index,
+                            &mShadowSamples);
+}
+
+double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index,
+                                         std::size_t light, const FrontRearProfile& reflects,
+                                         const StripProfile* behind, double xi, double w,
+                                         double tIn, double tMid, double tOut)
+{
+    constexpr int kShadowStrips = 4;
+    const TracedBough& b = mScene.bough(index);
+    const double R = b.radius_cm;
+    const double lo = std::max(xi - 0.5 * w, -R), hi = std::min(xi + 0.5 * w, R);
+    const Vec3& L = mLight[light].towards;
+    const Vec3 across = ray.direction - glm::dot(ray.direction, L) * L;
+    const double stretch = glm::length(across);
+    mShadowSamples.across = stretch > 1e-9 ? across / stretch : Vec3(0.0);
+    const Vec3 sideways = glm::cross(L, mShadowSamples.across);
+    const double side = glm::length(sideways);
+    mShadowSamples.sideways = side > 1e-9 ? sideways / side : Vec3(0.0);
+    mShadowSamples.footprintNormal = ray.direction;
+    mShadowSamples.points.clear();
+    const double strip = (hi - lo) / kShadowStrips;  // cm across each
+    for (int k = 0; k < kShadowStrips && strip > 0.0; ++k) {
+        const double at = lo + (k + 0.5) * strip;
+        // What each half reflects over this strip (the rear as seen through the front).
+        const double front = reflects.front.overFootprint(at, R, strip) * strip;
+        double rear = reflects.rear.overFootprint(at, R, strip) * strip;
+        if (behind) rear *= 1.0 - behind->overFootprint(at, R, strip);
+        // Along the chord, each half's needles at the centres of its thirds.
+        for (int j = 0; j < 3; ++j) {
+            const double u = (j + 0.5) / 3.0;
+            for (const auto& [t, weight] : {std::pair{tIn + u * (tMid - tIn), front},
+                                            std::pair{tMid + u * (tOut - tMid), rear}}) {
+                // From the chord's middle to the point: along the ray, then across the strip.
+                const Vec3 d = (t - tMid) * ray.direction + (at - xi) * b.across;
+                const Vec3 flat = d - glm::dot(d, L) * L;
+                mShadowSamples.points.push_back({glm::dot(flat, mShadowSamples.across),
+                                                 weight / 3.0,
+                                                 glm::dot(flat, mShadowSamples.sideways),
+                                                 glm::dot(d, L)});
+            }
+        }
+    }
+    if (!(strip > 0.0)) return shadowOf(ray, index, light, tMid);
+    return mSurfaces.shadow(light, ray.origin + tMid * ray.direction, strip, index,
                             &mShadowSamples);
 }
 
@@ -386,15 +442,19 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         } else if (mPlan.shadowRays && mScene.shadowOrigin == ShadowOrigin::Axis) {
             mLight[i].irradiance *= mSurfaces.shadow(i, ray.origin + p.t * ray.direction, w, index);
         } else if (mPlan.shadowRays) {
-            // Each half's needles that reflect the light lie along its half of the chord:
-            // three points at the centres of its thirds.
-            mDepths.clear();
-            for (int k = 0; k < 3; ++k) {
-                const double u = (k + 0.5) / 3.0;
-                mDepths.push_back({tIn + u * (tMid - tIn), tf / 3.0});
-                mDepths.push_back({tMid + u * (tOut - tMid), (1.0 - front.alpha) * tr / 3.0});
+            // Each half's needles that reflect the light lie about the middle of its half of
+            // the chord, across the strip as the law's transfer says.
+            if (!(tOut > tIn)) {
+                // A chord of no length (the cone grazes the strip): its one point.
+                mDepths.assign(1, {tMid, tf + (1.0 - front.alpha) * tr});
+                mLight[i].irradiance *= shadowOf(ray, index, i, tMid);
+            } else {
+                mLight[i].irradiance *=
+                    shadowAcross(ray, index, i, transfer,
+                                 b.rearComposite == RearComposite::Share ? nullptr
+                                                                         : &view.alpha.front,
+                                 xi, w, tIn, tMid, tOut);
             }
-            mLight[i].irradiance *= shadowOf(ray, index, i, tMid);
         }
         const Vec3& E = mLight[i].irradiance;
         // What each half reflects: the law's sum over its needles, or (the paper's laws) the
