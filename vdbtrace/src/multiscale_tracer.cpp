@@ -170,7 +170,10 @@ double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index,
             }
         }
     }
-    if (!(strip > 0.0)) return shadowOf(ray, index, light, tMid);
+    if (!(strip > 0.0)) {  // a footprint of no width: the line's middle
+        mDepths.assign(1, {tMid, 1.0});
+        return shadowOf(ray, index, light, tMid);
+    }
     return mSurfaces.shadow(light, ray.origin + tMid * ray.direction, strip, index,
                             &mShadowSamples);
 }
@@ -442,8 +445,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         } else if (mPlan.shadowRays && mScene.shadowOrigin == ShadowOrigin::Axis) {
             mLight[i].irradiance *= mSurfaces.shadow(i, ray.origin + p.t * ray.direction, w, index);
         } else if (mPlan.shadowRays) {
-            // Each half's needles that reflect the light lie about the middle of its half of
-            // the chord, across the strip as the law's transfer says.
+            // Each half's needles that reflect the light lie along its half of the chord, and
+            // across the strip as the law's transfer says.
             if (!(tOut > tIn)) {
                 // A chord of no length (the cone grazes the strip): its one point.
                 mDepths.assign(1, {tMid, tf + (1.0 - front.alpha) * tr});
