@@ -72,13 +72,13 @@ const std::vector<RenderMethod>& renderMethods()
     static const std::vector<RenderMethod> methods = {
         {"multiscale", "closed forms, each hit at the level its footprint calls for",
          multiscale, describeMultiscale, oneCone, true, true,
-         TracedSceneParts{true, true, false}},
+         TracedSceneParts{.grownTrees = false}},
         // The reference marches one set of grids merged from every tree.
         {"reference", "equation 7 numerically through OpenVDB grids of the boughs", reference,
          describeReference, referenceRays, false, false, TracedSceneParts{}},
         {"geometry", "explicit needle cylinders, point samples (the ground truth)", geometry,
          describeGeometry, geometrySamples, false, true,
-         TracedSceneParts{false, false, true}},
+         TracedSceneParts{.primitiveIndex = false, .boughLaws = false}},
     };
     return methods;
 }

@@ -170,7 +170,7 @@ double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index,
             }
         }
     }
-    if (!(strip > 0.0)) {  // a footprint of no width: the line's middle
+    if (!(strip > 0.0) || !(tOut > tIn)) {  // a footprint or a chord of no width: its middle
         mDepths.assign(1, {tMid, 1.0});
         return shadowOf(ray, index, light, tMid);
     }
@@ -447,17 +447,11 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         } else if (mPlan.shadowRays) {
             // Each half's needles that reflect the light lie along its half of the chord, and
             // across the strip as the law's transfer says.
-            if (!(tOut > tIn)) {
-                // A chord of no length (the cone grazes the strip): its one point.
-                mDepths.assign(1, {tMid, tf + (1.0 - front.alpha) * tr});
-                mLight[i].irradiance *= shadowOf(ray, index, i, tMid);
-            } else {
-                mLight[i].irradiance *=
-                    shadowAcross(ray, index, i, transfer,
-                                 b.rearComposite == RearComposite::Share ? nullptr
-                                                                         : &view.alpha.front,
-                                 xi, w, tIn, tMid, tOut);
-            }
+            mLight[i].irradiance *=
+                shadowAcross(ray, index, i, transfer,
+                             b.rearComposite == RearComposite::Share ? nullptr
+                                                                     : &view.alpha.front,
+                             xi, w, tIn, tMid, tOut);
         }
         const Vec3& E = mLight[i].irradiance;
         // What each half reflects: the law's sum over its needles, or (the paper's laws) the

@@ -182,8 +182,9 @@ const StripProfile& TracedBough::opacityFromLight(std::size_t light) const
 
 namespace {
 
+// `evaluated`: the bough gets its law evaluation (else view() throws).
 TracedBough makeTracedBough(const BoughDescription& d,
-                            const std::shared_ptr<const BoughLawContext>& context)
+                            const std::shared_ptr<const BoughLawContext>& context, bool evaluated)
 {
     const BoughLaw& law = *context->law;
     TracedBough b;
@@ -208,11 +209,13 @@ TracedBough makeTracedBough(const BoughDescription& d,
     b.stripEnd_cm = traits.stripToConesEnd ? b.conesEnd_cm : b.tip_cm;
     b.shadesNeedles = traits.shadesNeedles;
 
-    auto e = std::make_shared<BoughLawEvaluation>();
-    e->context = context;
-    e->fromLight = std::make_unique<BoughLawEvaluation::FromLight[]>(context->lights.size());
     b.across = stripAcross(b.axis, glm::normalize(context->eye_cm - boughCentre(b)));
-    b.law = std::move(e);
+    if (evaluated) {
+        auto e = std::make_shared<BoughLawEvaluation>();
+        e->context = context;
+        e->fromLight = std::make_unique<BoughLawEvaluation::FromLight[]>(context->lights.size());
+        b.law = std::move(e);
+    }
     return b;
 }
 
@@ -236,7 +239,7 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
                             const std::vector<Light>& lights, const BoughLaw& law,
                             const LayerModel& layers, const BoughLawNeeds& needs)
 {
-    return makeTracedBough(d, lawContext(eye_cm, lights, law, layers, needs));
+    return makeTracedBough(d, lawContext(eye_cm, lights, law, layers, needs), true);
 }
 
 void computeLawProfiles(const TracedScene& scene)
@@ -373,8 +376,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
         }
         for (std::size_t k = 0; k < described[i].size(); ++k) {
             TracedBough& b = out.boughs[firstBough[i] + k];
-            b = makeTracedBough(described[i][k], context);
-            if (!parts.boughLaws) b.law.reset();
+            b = makeTracedBough(described[i][k], context, parts.boughLaws);
         }
         std::vector<BoughDescription>().swap(described[i]);
     });

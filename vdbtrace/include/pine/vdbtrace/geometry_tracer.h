@@ -2,8 +2,9 @@
 // bough (the same needles the multiscale level 1 draws, needle_layout.h) and every branch is
 // a solid cylinder in one Embree 3 BVH (a scatter variant's needles once, instanced at each of
 // its trees); each pixel takes N point samples, each hit is shaded with the per-point
-// integrands of the paper's eqs. (1) and (2) (section 4), lit through shadow rays. Averaged over a needle's visible surface these give eqs. (1)-(2) times its
-// projected area, so the multiscale and reference tracers can be measured against it.
+// integrands of the paper's eqs. (1) and (2) (section 4), lit through shadow rays. Averaged
+// over a needle's visible surface these give eqs. (1)-(2) times its projected area, so the
+// multiscale and reference tracers can be measured against it.
 #pragma once
 
 #include "pine/vdbtrace/render_result.h"

@@ -167,8 +167,8 @@ std::vector<std::string> shadowOriginNames();
 /// The values of render.bark, the faithful one first.
 std::vector<std::string> barkNames();
 
-/// What a method needs of the traced scene beyond its trees, branches and boughs (each method
-/// says, RenderMethod::parts). The geometry method walks an Embree BVH of its own and never
+/// What a method needs of the traced scene beyond its branches and boughs (each method says,
+/// RenderMethod::parts). The geometry method walks an Embree BVH of its own and never
 /// asks a bough's law: without them a landscape's 3.3 million boughs take about 40% less
 /// memory.
 struct TracedSceneParts {
