@@ -97,7 +97,11 @@ TEST(CorrectedBoughLaw, AgreesWithTheExactLaw)
     // The truth: the exact law with 16 times its chords per cell.
     const std::unique_ptr<BoughLaw> truth = makeExactBoughLaw(16);
     const BoughLaw& exact = boughLaw("exact");
-    const LayerModel& layers = layerModel("fibre");
+    // Under the layers' independent crossings: with layer_correlation "needles" the hot spot
+    // puts a sharp peak near the view into the transfer and diffuse tables, which the grids
+    // resolve less well (measured: mean errors up to 0.044 and 0.066, diffuse cells' p90
+    // 0.20; docs/models.md "Layer correlation").
+    const LayerModel& layers = layerModel("fibre", "independent");
     std::mt19937 rng(2026);
     std::uniform_real_distribution<double> u;
     enum { kCoverage, kFromLight, kTransfer, kDiffuse, kSpecular, kQuantities };

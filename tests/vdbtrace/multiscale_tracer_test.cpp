@@ -284,6 +284,12 @@ TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
     expectInputError([&] { buildTracedScene(scene); },
                      "fir.json: render.shadow_origin: unknown shadow origin 'sun' (known: "
                      "needles, axis, bough)");
+    EXPECT_EQ(layerCorrelationNames().front(), scenes::ModelChoices{}.layerCorrelation);
+    scene.render.model = {};
+    scene.render.model.layerCorrelation = "some";
+    expectInputError([&] { buildTracedScene(scene); },
+                     "fir.json: render.layer_correlation: unknown layer correlation 'some' "
+                     "(known: needles, independent)");
 }
 
 TEST(MultiscaleTracer, ConeLevelCrossesTheTrueCones)

@@ -135,7 +135,7 @@ public:
                 const Vec3& L = towardsLights[i];
                 const double seen =
                     shown.share *
-                    (needs.transfer ? layers.transmittance(b, shown.x, L, shown.cone) : 1.0);
+                    (needs.transfer ? layers.transmittance(b, shown.x, L, shown.cone, V) : 1.0);
                 lit[shown.half][i][shown.cell] += seen;
                 if (needs.diffuse) {
                     diffuse[shown.half][i][shown.cell] +=

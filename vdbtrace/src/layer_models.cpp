@@ -1,31 +1,51 @@
 // The registry of layer models: to add one, write its type in a file of its own (as
-// fibre_layer_model.cpp), declare its factory here and add it to the table.
+// fibre_layer_model.cpp), declare its factory here and add it to the tables, one per layer
+// correlation (render.layer_correlation).
 #include "pine/vdbtrace/layer_model.h"
 
 #include "pine/support/registry.h"
 
 namespace pine::vdbtrace {
 
-std::unique_ptr<LayerModel> makeFibreLayerModel();
+std::unique_ptr<LayerModel> makeFibreLayerModel(bool correlated);
 std::unique_ptr<LayerModel> makePaperLayerModel();
 
 namespace {
 
-const Registry<LayerModel>& registry()
+// The models whose crossings of one cone share its needles (render.layer_correlation
+// "needles"), and those whose crossings are each independent ("independent").
+const Registry<LayerModel>& registry(bool correlated)
 {
-    static const Registry<LayerModel> models = [] {
+    static const auto table = [](bool c) {
         Registry<LayerModel> r("layer model");
-        r.add("fibre", makeFibreLayerModel());  // the needles' own statistics (faithful)
-        r.add("paper", makePaperLayerModel());  // constant A whatever the crossing (sec. 3.3)
+        r.add("fibre", makeFibreLayerModel(c));  // the needles' own statistics (faithful)
+        r.add("paper", makePaperLayerModel());   // constant A whatever the crossing (sec. 3.3)
         return r;
+    };
+    static const Registry<LayerModel> correlatedModels = table(true), independent = table(false);
+    return correlated ? correlatedModels : independent;
+}
+
+const Registry<const bool>& correlations()
+{
+    static const Registry<const bool> r = [] {
+        Registry<const bool> out("layer correlation");
+        out.add("needles", std::make_unique<const bool>(true));
+        out.add("independent", std::make_unique<const bool>(false));
+        return out;
     }();
-    return models;
+    return r;
 }
 
 }  // namespace
 
-const LayerModel& layerModel(const std::string& name) { return registry().get(name); }
+const LayerModel& layerModel(const std::string& name, const std::string& correlation)
+{
+    return registry(correlations().get(correlation)).get(name);
+}
 
-std::vector<std::string> layerModelNames() { return registry().names(); }
+std::vector<std::string> layerModelNames() { return registry(true).names(); }
+
+std::vector<std::string> layerCorrelationNames() { return correlations().names(); }
 
 }  // namespace pine::vdbtrace

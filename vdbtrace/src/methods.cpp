@@ -20,6 +20,7 @@ nlohmann::json describeMultiscale(const scenes::Scene& scene, const MethodSettin
             {"shadow_origin", scene.render.model.shadowOrigin},
             {"level_blend", scene.render.model.levelBlend},
             {"bark", scene.render.model.bark},
+            {"layer_correlation", scene.render.model.layerCorrelation},
             {"needle_level_max", scene.render.needleLevelMax},
             {"cone_level_max", scene.render.model.coneLevelMax}};
 }

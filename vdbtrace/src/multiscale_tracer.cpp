@@ -195,7 +195,8 @@ void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
             for (std::size_t i = 0; i < lights; ++i) {
                 ++mStats.selfShadowEvaluations;
                 mSelf[h * lights + i] =
-                    mScene.layers->transmittance(b, x, mLight[i].towards, mNeedleHits[h].cone);
+                    mScene.layers->transmittance(b, x, mLight[i].towards, mNeedleHits[h].cone,
+                                                 -ray.direction);
             }
         }
     }

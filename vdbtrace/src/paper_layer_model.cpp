@@ -21,8 +21,8 @@ public:
         });
     }
 
-    double transmittance(const TracedBough& b, const Vec3& x, const Vec3& towardsLight,
-                         long) const override
+    double transmittance(const TracedBough& b, const Vec3& x, const Vec3& towardsLight, long,
+                         const Vec3&) const override
     {
         double tIn, tOut;
         if (!layeredInterval(b, x, towardsLight, tIn, tOut)) return 1.0;

@@ -309,8 +309,11 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     };
     const std::shared_ptr<const BoughLaw> law =
         chosen("bough_law", [&] { return boughLaw(model.boughLaw).fresh(); });
+    chosen("layer_correlation", [&]() -> const LayerModel& {
+        return layerModel("fibre", model.layerCorrelation);
+    });
     const LayerModel& layers = chosen("layer_model", [&]() -> const LayerModel& {
-        return layerModel(model.layerModel);
+        return layerModel(model.layerModel, model.layerCorrelation);
     });
     const ShadowOrigin origin =
         chosen("shadow_origin", [&] { return shadowOrigins().get(model.shadowOrigin); });

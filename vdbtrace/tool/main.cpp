@@ -60,7 +60,7 @@ vdbtrace::RenderOptions withProgress(tool::Progress& shown)
 // it): --paper first, then each law named.
 struct ModelOverrides {
     bool paper = false;
-    std::string boughLaw, layerModel, extinctionLaw, shadowOrigin, bark;
+    std::string boughLaw, layerModel, extinctionLaw, shadowOrigin, bark, layerCorrelation;
     double levelBlend = 0.0;    ///< 0: the scene's
     double coneLevelMax = 0.0;  ///< 0: the scene's
 
@@ -69,7 +69,8 @@ struct ModelOverrides {
         cmd.add_flag("--paper", paper,
                      "Every approximation as the paper prints it (render.preset \"paper\"): "
                      "bough law linear, layer model paper, extinction law layer, shadow origin axis, "
-                     "no level blend, bark line, level 3 from q = 1");
+                     "no level blend, bark line, level 3 from q = 1, layer correlation "
+                     "independent");
         cmd.add_option("--bough-law", boughLaw, "multiscale level 3's law (render.bough_law)")
             ->check(CLI::IsMember(vdbtrace::boughLawNames()));
         cmd.add_option("--layer-model", layerModel,
@@ -92,6 +93,11 @@ struct ModelOverrides {
                        "multiscale: solid (the needles' roots inside the branch are hidden) or "
                        "line (the branch is the bough's axis, the paper's; render.bark)")
             ->check(CLI::IsMember(vdbtrace::barkNames()));
+        cmd.add_option("--layer-correlation", layerCorrelation,
+                       "multiscale: self-shadowing through the fibre layers; needles (the view's "
+                       "and the light's lines through one cone meet the same needles: the hot "
+                       "spot) or independent (the paper's; render.layer_correlation)")
+            ->check(CLI::IsMember(vdbtrace::layerCorrelationNames()));
         cmd.add_option("--cone-level-max", coneLevelMax,
                        "multiscale: level 3 (the bough a volume) from this footprint over cone "
                        "spacing q on, level 2 below; the paper's 1 (render.cone_level_max)")
@@ -106,6 +112,7 @@ struct ModelOverrides {
         if (!shadowOrigin.empty()) model.shadowOrigin = shadowOrigin;
         if (levelBlend > 0.0) model.levelBlend = levelBlend;
         if (!bark.empty()) model.bark = bark;
+        if (!layerCorrelation.empty()) model.layerCorrelation = layerCorrelation;
         if (coneLevelMax > 0.0) model.coneLevelMax = coneLevelMax;
     }
 };

@@ -101,8 +101,15 @@ struct ModelChoices {
     /// level 2 agrees with the needles where level 3 does not, but beyond q ~ 1.4 one line a
     /// pixel through the layers aliases (docs/models.md "Level threshold").
     double coneLevelMax = 1.0;
+    /// Self-shadowing through the fibre layers: "needles" (the lines of the view and of the
+    /// light through one cone meet its same evenly spaced needles: the hot spot) or
+    /// "independent" (every crossing on its own, section 6).
+    std::string layerCorrelation = "needles";
     /// Every choice as the paper prints it (preset "paper"): today's published behaviour.
-    static ModelChoices paper() { return {"linear", "paper", "layer", "axis", 1.0, "line", 1.0}; }
+    static ModelChoices paper()
+    {
+        return {"linear", "paper", "layer", "axis", 1.0, "line", 1.0, "independent"};
+    }
     /// The choices that agree with the explicit needles (preset "faithful", the default).
     static ModelChoices faithful() { return {}; }
 };
@@ -110,7 +117,7 @@ struct ModelChoices {
 struct RenderSettings {
     Vec3 background{0.55, 0.7, 0.9};
     /// preset, then bough_law, layer_model, extinction_law, shadow_origin, level_blend, bark,
-    /// cone_level_max
+    /// cone_level_max, layer_correlation
     ModelChoices model;
     /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
     /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):

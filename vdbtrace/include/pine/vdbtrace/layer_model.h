@@ -28,14 +28,23 @@ public:
     virtual void layers(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn,
                         double tOut, const std::function<void(const LayerHit&)>& visit) const = 0;
     /// The light that reaches x on a needle of cone `ownCone` from unit direction
-    /// `towardsLight` through b's other layers (section 6's self-shadowing, counted).
+    /// `towardsLight` through b's other layers (section 6's self-shadowing, counted), for a
+    /// needle seen from unit direction `towardsViewer` through b's layers in front of it (a
+    /// model whose layers' needles lie where the view's line passed may condition on it: the
+    /// layer correlation; a zero vector: not seen, or not known).
     virtual double transmittance(const TracedBough& b, const Vec3& x, const Vec3& towardsLight,
-                                 long ownCone) const = 0;
+                                 long ownCone, const Vec3& towardsViewer) const = 0;
 };
 
-/// The model registered as `name`; throws InputError naming the registered ones.
-const LayerModel& layerModel(const std::string& name);
+/// The model registered as `name` under the layer correlation `correlation` (render.
+/// layer_correlation: "needles", the lines of the view and of the light through one cone meet
+/// the same evenly spaced needles, or "independent", every crossing on its own, section 6;
+/// a model without needle azimuths, as "paper", is independent either way); throws InputError
+/// naming the registered ones.
+const LayerModel& layerModel(const std::string& name, const std::string& correlation);
 /// The registered names, in registration order.
 std::vector<std::string> layerModelNames();
+/// The values of render.layer_correlation, the faithful one first.
+std::vector<std::string> layerCorrelationNames();
 
 }  // namespace pine::vdbtrace
