@@ -133,6 +133,7 @@ idiff -q -fail 1e-3 -failpercent 0.5 -warn 1e-3 -warnpercent 0.5 "$work/g.exr" "
     || fail "curves and cylinders differ: $(idiff -fail 1e-3 "$work/g.exr" "$work/gc.exr" | tail -3)"
 expect_error "an unknown primitive" 2 "needle-primitive" -- render "$src/scenes/bough.json" --method geometry --out "$work/a.exr" --needle-primitive capsule
 expect_error "an unknown bark" 2 "bark" -- render "$src/scenes/bough.json" --out "$work/a.exr" --bark wood
+expect_error "an unknown layer correlation" 2 "layer-correlation" -- render "$src/scenes/bough.json" --out "$work/a.exr" --layer-correlation some
 expect_error "another method's option" 2 "sample-seed applies to --method geometry, not multiscale" -- render "$src/scenes/bough.json" --out "$work/a.exr" --sample-seed 3
 # A crop is the whole frame's pixels, as the EXR's data window; --resolution keeps the view;
 # --quiet leaves stderr empty on success.
@@ -170,6 +171,8 @@ grep -q '"shadow_origin": "axis"' "$work/p.json" || fail "--paper did not choose
 grep -q '"shadow_origin": "needles"' "$work/b.json" || fail "default shadow origin not recorded as needles"
 grep -q '"level_blend": 1.5' "$work/b.json" || fail "default level blend not recorded as 1.5"
 grep -q '"level_blend": 1.0' "$work/p.json" || fail "--paper did not turn the level blend off"
+grep -q '"layer_correlation": "needles"' "$work/b.json" || fail "default layer correlation not recorded as needles"
+grep -q '"layer_correlation": "independent"' "$work/p.json" || fail "--paper did not make the layers independent"
 "$vdbtrace" render "$src/scenes/bough.json" --paper --layer-model fibre --out "$work/p.exr" --stats "$work/p.json" 2>/dev/null \
     || fail "render --paper --layer-model fibre failed"
 grep -q '"layer_model": "fibre"' "$work/p.json" || fail "--layer-model did not override --paper"
