@@ -18,7 +18,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
 #include <string>
 
@@ -96,7 +95,6 @@ double multiscale(double angle_deg, int level, const std::string& layers,
     m.forceLevel = level;
     return totalOpacity(renderMultiscale(LongBough(angle_deg, options).traced, m));
 }
-
 
 TEST(FaithfulModels, EveryLevelCoversWhatTheNeedlesCover)
 {

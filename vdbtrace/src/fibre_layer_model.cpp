@@ -21,8 +21,7 @@
 // needles leave one gap a period.) Without it (layer_correlation "independent", the paper's
 // section 6) every band is independent. One long bough lit from 3 degrees off the camera gets
 // 0.84 of the needles' self-shadowed light at level 1 with "independent", 0.98 with "needles"
-// (FaithfulModels.ALoneBoughUnderEveryLight; docs/models.md "Self-shadowing under every
-// light").
+// (FaithfulModels.ALoneBoughUnderEveryLight; docs/models.md "Layer correlation").
 #include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/layer_model.h"
 

@@ -309,6 +309,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     };
     const std::shared_ptr<const BoughLaw> law =
         chosen("bough_law", [&] { return boughLaw(model.boughLaw).fresh(); });
+    // Looked up apart first, so that an unknown correlation is refused under its own key.
     chosen("layer_correlation", [&]() -> const LayerModel& {
         return layerModel("fibre", model.layerCorrelation);
     });

@@ -68,8 +68,8 @@ struct ModelOverrides {
     {
         cmd.add_flag("--paper", paper,
                      "Every approximation as the paper prints it (render.preset \"paper\"): "
-                     "bough law linear, layer model paper, extinction law layer, shadow origin axis, "
-                     "no level blend, bark line, level 3 from q = 1, layer correlation "
+                     "bough law linear, layer model paper, extinction law layer, shadow origin "
+                     "axis, no level blend, bark line, level 3 from q = 1, layer correlation "
                      "independent");
         cmd.add_option("--bough-law", boughLaw, "multiscale level 3's law (render.bough_law)")
             ->check(CLI::IsMember(vdbtrace::boughLawNames()));
