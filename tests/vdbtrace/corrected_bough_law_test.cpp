@@ -101,7 +101,7 @@ TEST(CorrectedBoughLaw, AgreesWithTheExactLaw)
     // puts a sharp peak near the view into the transfer and diffuse tables, which the grids
     // resolve less well (measured: mean errors up to 0.044 and 0.066, diffuse cells' p90
     // 0.20; docs/models.md "Layer correlation").
-    const LayerModel& layers = layerModel("fibre", "independent");
+    const LayerModel& layers = layerModel("fibre", /*correlated=*/false);
     std::mt19937 rng(2026);
     std::uniform_real_distribution<double> u;
     enum { kCoverage, kFromLight, kTransfer, kDiffuse, kSpecular, kQuantities };

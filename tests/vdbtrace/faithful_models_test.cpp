@@ -56,7 +56,7 @@ struct LongBough {
         d.seed = seed;
         traced.boughs.push_back(makeTracedBough(
             d, scene.camera.position_cm, traced.lights, boughLaw(model.boughLaw),
-            layerModel(model.layerModel, model.layerCorrelation),
+            layerModel(model.layerModel, layerCorrelated(model.layerCorrelation)),
             BoughLawNeeds::from(EffectsPlan::from(scene.effects))));
         indexPrimitives(traced);
     }

@@ -39,10 +39,12 @@ const Registry<const bool>& correlations()
 
 }  // namespace
 
-const LayerModel& layerModel(const std::string& name, const std::string& correlation)
+const LayerModel& layerModel(const std::string& name, bool correlated)
 {
-    return registry(correlations().get(correlation)).get(name);
+    return registry(correlated).get(name);
 }
+
+bool layerCorrelated(const std::string& name) { return correlations().get(name); }
 
 std::vector<std::string> layerModelNames() { return registry(true).names(); }
 

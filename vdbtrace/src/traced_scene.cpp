@@ -309,12 +309,10 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     };
     const std::shared_ptr<const BoughLaw> law =
         chosen("bough_law", [&] { return boughLaw(model.boughLaw).fresh(); });
-    // Looked up apart first, so that an unknown correlation is refused under its own key.
-    chosen("layer_correlation", [&]() -> const LayerModel& {
-        return layerModel("fibre", model.layerCorrelation);
-    });
+    const bool correlated =
+        chosen("layer_correlation", [&] { return layerCorrelated(model.layerCorrelation); });
     const LayerModel& layers = chosen("layer_model", [&]() -> const LayerModel& {
-        return layerModel(model.layerModel, model.layerCorrelation);
+        return layerModel(model.layerModel, correlated);
     });
     const ShadowOrigin origin =
         chosen("shadow_origin", [&] { return shadowOrigins().get(model.shadowOrigin); });

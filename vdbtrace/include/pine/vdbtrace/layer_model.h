@@ -36,14 +36,17 @@ public:
                                  long ownCone, const Vec3& towardsViewer) const = 0;
 };
 
-/// The model registered as `name` under the layer correlation `correlation` (render.
-/// layer_correlation: "needles", the lines of the view and of the light through one cone meet
-/// the same evenly spaced needles, or "independent", every crossing on its own, section 6;
-/// a model without needle azimuths, as "paper", is independent either way); throws InputError
-/// naming the registered ones.
-const LayerModel& layerModel(const std::string& name, const std::string& correlation);
+/// The model registered as `name`, its crossings of one cone `correlated` or not (see
+/// layerCorrelated; a model without needle azimuths, as "paper", is independent either way);
+/// throws InputError naming the registered ones.
+const LayerModel& layerModel(const std::string& name, bool correlated);
 /// The registered names, in registration order.
 std::vector<std::string> layerModelNames();
+/// Whether the render.layer_correlation `name` correlates a cone's crossings: "needles" (the
+/// lines of the view and of the light through one cone meet its same evenly spaced needles)
+/// does, "independent" (every crossing on its own, section 6) does not; throws InputError
+/// naming the known ones.
+bool layerCorrelated(const std::string& name);
 /// The values of render.layer_correlation, the faithful one first.
 std::vector<std::string> layerCorrelationNames();
 
