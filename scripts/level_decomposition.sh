@@ -20,53 +20,16 @@
 # Takes about seven minutes on 2 cores. Uses build/bin (build first) and oiiotool.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bin=${VDBTRACE:-build/bin/vdbtrace}
-[ -x "$bin" ] || { echo "level_decomposition: $bin is missing: build first" >&2; exit 2; }
-command -v oiiotool >/dev/null || { echo "level_decomposition: oiiotool is missing" >&2; exit 2; }
+tool=level_decomposition
 out=${1:-$(mktemp -d)}
-mkdir -p "$out"
+source scripts/forest_levels.sh
 
-# The forest at a resolution, with an effect set.
-scene() {  # scene NAME WIDTH HEIGHT EFFECTS_JSON [thin]
-  /usr/bin/python3 - "$out/$1.json" "$2" "$3" "$4" "${5:-}" <<'PY'
-import json, sys
-path, w, h, effects = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), json.loads(sys.argv[4])
-scene = json.load(open("scenes/paper-forest.json"))
-scene["camera"]["resolution"] = [w, h]
-scene["effects"] = effects
-if sys.argv[5] == "thin":
-    for species in scene["species"].values():
-        species["lsystem"]["trunk_radius"] /= 30
-json.dump(scene, open(path, "w"), indent=1)
-PY
-}
-# Renders NAME.json at level LEVEL into TAG.exr, box-downsampled to 320 x 240, measured
-# against the truth into TAG.diff.
-render() {  # render NAME LEVEL TAG [TRUTH]
-  echo "level_decomposition: $3" >&2
-  "$bin" render "$out/$1.json" --force-level "$2" --out "$out/$3.full.exr" 2>/dev/null
-  oiiotool "$out/$3.full.exr" --resize:filter=box 320x240 -o "$out/$3.exr"
-  "$bin" diff "$out/$3.exr" "$out/${4:-truth}.exr" --out "$out/$3.diff" >/dev/null 2>&1
-}
-per_tree() {  # per_tree LABEL TAG
-  /usr/bin/python3 - "$1" "$out/$2.diff/errors.json" <<'PY'
-import json, statistics, sys
-rows = json.load(open(sys.argv[2]))["trees"]
-line = "%-34s" % sys.argv[1]
-for key in ("coverage_bias", "luminance_bias"):
-    b = [r[key] for r in rows]
-    worst = max(b, key=abs)
-    line += "  %s median %+5.1f%% worst %+5.1f%% off %2d/%d" % (
-        key[:3], 100 * statistics.median(b), 100 * worst, sum(abs(x) > 0.03 for x in b), len(b))
-print(line)
-PY
-}
 ratio() {  # ratio LABEL TAG BASE: TAG against BASE, per tree
   /usr/bin/python3 - "$1" "$out/$2.diff/errors.json" "$out/$3.diff/errors.json" <<'PY'
 import json, statistics, sys
 load = lambda p: {r["tree"]: r for r in json.load(open(p))["trees"]}
 a, b = load(sys.argv[2]), load(sys.argv[3])
-line = "%-34s" % sys.argv[1]
+line = "%-44s" % sys.argv[1]
 for key in ("coverage_bias", "luminance_bias"):
     r = sorted((1 + a[k][key]) / (1 + b[k][key]) - 1 for k in a if k in b)
     line += "  %s median %+5.1f%% p10 %+5.1f%% p90 %+5.1f%% off %2d/%d" % (
@@ -77,31 +40,27 @@ PY
 }
 
 all='["diffuse", "self_shadowing", "shadows"]'
-scene x1 320 240 "$all"
-scene x4 1280 960 "$all"
-scene x8 2560 1920 "$all"
-echo "level_decomposition: truth, ${TRUTH_SPP:-1024} spp" >&2
-"$bin" render "$out/x1.json" --method geometry --samples "${TRUTH_SPP:-1024}" \
-    --out "$out/truth.exr" 2>/dev/null
+forest_scene x1 320 240 "$all"
+forest_scene x4 1280 960 "$all"
+forest_scene x8 2560 1920 "$all"
+truth x1 truth
 
 echo "Per tree against the needles, every effect (self-shadowing, shadows):"
-render x1 3 L3; per_tree "level 3 at the scene's footprints" L3
-render x1 2 L2; per_tree "level 2 at the scene's footprints" L2
-render x4 3 L3.fine; per_tree "level 3, footprints / 4" L3.fine
-render x4 2 L2.fine; per_tree "level 2, footprints / 4" L2.fine
-render x8 1 L1.fine; per_tree "level 1, footprints / 8" L1.fine
+render_level x1 3 L3; per_tree "level 3 at the scene's footprints" L3
+render_level x1 2 L2; per_tree "level 2 at the scene's footprints" L2
+render_level x4 3 L3.fine; per_tree "level 3, footprints / 4" L3.fine
+render_level x4 2 L2.fine; per_tree "level 2, footprints / 4" L2.fine
+render_level x8 1 L1.fine; per_tree "level 1, footprints / 8" L1.fine
 
 echo
 echo "The same with branches 30 times thinner, against needles of their own:"
-scene thin1 320 240 "$all" thin
-scene thin4 1280 960 "$all" thin
-scene thin8 2560 1920 "$all" thin
-echo "level_decomposition: thin-branch truth" >&2
-"$bin" render "$out/thin1.json" --method geometry --samples "${TRUTH_SPP:-1024}" \
-    --out "$out/thin.truth.exr" 2>/dev/null
-render thin1 3 thin.L3 thin.truth; per_tree "level 3 at the scene's footprints" thin.L3
-render thin4 3 thin.L3.fine thin.truth; per_tree "level 3, footprints / 4" thin.L3.fine
-render thin8 1 thin.L1.fine thin.truth; per_tree "level 1, footprints / 8" thin.L1.fine
+forest_scene thin1 320 240 "$all" thin
+forest_scene thin4 1280 960 "$all" thin
+forest_scene thin8 2560 1920 "$all" thin
+truth thin1 thin.truth
+render_level thin1 3 thin.L3 thin.truth; per_tree "level 3 at the scene's footprints" thin.L3
+render_level thin4 3 thin.L3.fine thin.truth; per_tree "level 3, footprints / 4" thin.L3.fine
+render_level thin8 1 thin.L1.fine thin.truth; per_tree "level 1, footprints / 8" thin.L1.fine
 
 echo
 echo "Per tree against level 1 (footprints / 8), the effects added one by one:"
@@ -114,11 +73,11 @@ for effects in diffuse self shadows; do
   if [ "$effects" = shadows ]; then
     base=L1.fine; l2=L2.fine; l3=L3.fine
   else
-    scene "e4.$effects" 1280 960 "$set"
-    scene "e8.$effects" 2560 1920 "$set"
-    render "e8.$effects" 1 "L1.$effects"; base="L1.$effects"
-    render "e4.$effects" 2 "L2.$effects"; l2="L2.$effects"
-    render "e4.$effects" 3 "L3.$effects"; l3="L3.$effects"
+    forest_scene "e4.$effects" 1280 960 "$set"
+    forest_scene "e8.$effects" 2560 1920 "$set"
+    render_level "e8.$effects" 1 "L1.$effects"; base="L1.$effects"
+    render_level "e4.$effects" 2 "L2.$effects"; l2="L2.$effects"
+    render_level "e4.$effects" 3 "L3.$effects"; l3="L3.$effects"
   fi
   ratio "level 2 / level 1, + $effects" "$l2" "$base"
   ratio "level 3 / level 1, + $effects" "$l3" "$base"
