@@ -106,6 +106,61 @@ TEST(Bvh, FindsEveryBoxTheConeTouches)
     }
 }
 
+// The multiscale tracer's front-to-back walk: the same primitives as query, each bounded by
+// its own ball, in the order sorting them all by (bound, index) gives, the caller's own entry
+// (the ground) in its turn, and nothing after the visit that stops it. Cylinders of random
+// lengths and radii whose balls stick far out of their boxes, some sharing a bound exactly.
+TEST(Bvh, VisitsNearestFirstAsSortingWould)
+{
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-50.0, 50.0), len(0.0, 30.0), r(0.01, 2.0);
+    std::vector<Aabb> boxes;
+    std::vector<Sphere> balls;
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 a(u(rng), u(rng), u(rng));
+        const Vec3 dir = glm::normalize(Vec3(u(rng), u(rng), u(rng)));
+        const Vec3 b = i % 7 == 0 ? a : a + len(rng) * dir;
+        const double radius = r(rng);
+        boxes.push_back(cylinderBounds(a, b, radius));
+        balls.push_back(cylinderSphere(a, b, radius));
+        if (i % 11 == 0) {  // a twin: the same ball, so the same bound
+            boxes.push_back(boxes.back());
+            balls.push_back(balls.back());
+        }
+    }
+    const Bvh bvh(boxes, balls);
+    NearestFirstQueue queue;
+    std::size_t candidates = 0;  // over all rays
+    for (int k = 0; k < 100; ++k) {
+        const ConeRay ray{Vec3(u(rng), u(rng), -80.0),
+                          glm::normalize(Vec3(0.5 * u(rng) / 50, 0.5 * u(rng) / 50, 1.0)),
+                          k % 2 ? 0.0 : 0.02};
+        const double tMax = k % 3 ? 1e9 : 90.0;
+        const std::uint32_t ground = std::uint32_t(-1);
+        const double tGround = 60.0 + k;
+        using Entry = std::pair<double, std::uint32_t>;
+        std::vector<Entry> sorted{{tGround, ground}};
+        bvh.query(ray, tMax, [&](std::uint32_t i) {
+            sorted.push_back({nearestAlong(ray, balls[i]), i});
+        });
+        std::sort(sorted.begin(), sorted.end());
+        const std::size_t stopAfter = k % 4 == 0 ? sorted.size() / 3 : sorted.size();
+        std::vector<Entry> visited;
+        queue.clear();
+        queue.add(tGround, ground);
+        bvh.nearestFirst(
+            ray, tMax, queue, [&](std::uint32_t i) { return nearestAlong(ray, balls[i]); },
+            [&](std::uint32_t i, double nearest) {
+                visited.push_back({nearest, i});
+                return visited.size() < stopAfter;
+            });
+        candidates += sorted.size();
+        sorted.resize(stopAfter);
+        EXPECT_EQ(visited, sorted) << "ray " << k;
+    }
+    EXPECT_GT(candidates, 3000u);  // enough to order
+}
+
 TEST(ConeCamera, FootprintIsOnePixelAtTheCentre)
 {
     scenes::Camera c;

@@ -4,11 +4,29 @@
 
 #include <algorithm>
 #include <numeric>
+#include <stdexcept>
 
 namespace pine::vdbtrace {
 
-Bvh::Bvh(const std::vector<Aabb>& boxes)
+namespace {
+
+std::vector<Sphere> circumscribed(const std::vector<Aabb>& boxes)
 {
+    std::vector<Sphere> balls;
+    balls.reserve(boxes.size());
+    for (const Aabb& b : boxes) balls.push_back({b.centre(), 0.5 * glm::length(b.hi - b.lo)});
+    return balls;
+}
+
+}  // namespace
+
+Bvh::Bvh(const std::vector<Aabb>& boxes) : Bvh(boxes, circumscribed(boxes)) {}
+
+Bvh::Bvh(const std::vector<Aabb>& boxes, const std::vector<Sphere>& balls)
+{
+    if (boxes.size() != balls.size()) {
+        throw std::invalid_argument("Bvh: one ball per box is needed");
+    }
     if (boxes.empty()) return;
     mIndices.resize(boxes.size());
     std::iota(mIndices.begin(), mIndices.end(), 0u);
@@ -17,13 +35,13 @@ Bvh::Bvh(const std::vector<Aabb>& boxes)
     // 3.5 million primitives, about 300 MB).
     mNodes.reserve(boxes.size());
     mNodes.emplace_back();
-    build(boxes, 0, 0, std::uint32_t(boxes.size()));
+    build(boxes, balls, 0, 0, std::uint32_t(boxes.size()));
 }
 
 // Fills node `node` (already allocated) for mIndices[first, first + count); an inner node's
 // two children are allocated next to each other.
-void Bvh::build(const std::vector<Aabb>& boxes, std::uint32_t node, std::uint32_t first,
-                std::uint32_t count)
+void Bvh::build(const std::vector<Aabb>& boxes, const std::vector<Sphere>& balls,
+                std::uint32_t node, std::uint32_t first, std::uint32_t count)
 {
     Aabb box, centres;
     for (std::uint32_t i = first; i < first + count; ++i) {
@@ -33,6 +51,14 @@ void Bvh::build(const std::vector<Aabb>& boxes, std::uint32_t node, std::uint32_
     mNodes[node].box = box;
     mNodes[node].centre = box.centre();
     mNodes[node].halfDiagonal = 0.5 * glm::length(box.hi - box.lo);
+    double reach = mNodes[node].halfDiagonal;
+    for (std::uint32_t i = first; i < first + count; ++i) {
+        const Sphere& ball = balls[mIndices[i]];
+        reach = std::max(reach, glm::length(ball.centre - box.centre()) + ball.radius);
+    }
+    // Grown a little past rounding, so that the node's nearest-first bound never exceeds a
+    // primitive's computed in floating point (a few ulps of scene-sized numbers).
+    mNodes[node].ballRadius = reach * (1.0 + 1e-9) + 1e-9;
     if (count <= 4) {
         mNodes[node].first = first;
         mNodes[node].count = count;
@@ -51,8 +77,8 @@ void Bvh::build(const std::vector<Aabb>& boxes, std::uint32_t node, std::uint32_
     mNodes.emplace_back();
     mNodes[node].first = left;
     mNodes[node].count = 0;
-    build(boxes, left, first, mid - first);
-    build(boxes, left + 1, mid, first + count - mid);
+    build(boxes, balls, left, first, mid - first);
+    build(boxes, balls, left + 1, mid, first + count - mid);
 }
 
 }  // namespace pine::vdbtrace

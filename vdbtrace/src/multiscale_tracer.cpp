@@ -93,12 +93,8 @@ private:
     RenderStats& mStats;
     SurfaceShading mSurfaces;
     std::vector<Fragment> mFragments;
-    struct Candidate {
-        double nearest;  ///< no fragment of the primitive lies nearer along the ray
-        std::uint32_t index;  ///< a BVH primitive or kGround
-    };
-    static constexpr std::uint32_t kGround = std::uint32_t(-1);
-    std::vector<Candidate> mCandidates;  ///< the primitives the ray may meet, nearest first
+    static constexpr std::uint32_t kGround = std::uint32_t(-1);  ///< in mQueue
+    NearestFirstQueue mQueue;  ///< the primitives the ray may yet meet
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
     std::vector<NeedleHit> mNeedleHits;               ///< a bough's needles on this ray
@@ -480,45 +476,34 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     mFragments.push_back(rear);
 }
 
-// No fragment of a primitive within `radius` of the segment a-b lies nearer along the ray
-// than this: its fragments lie within radius plus half the footprint of the segment (a level
-// 1 needle's within its cone's reach R plus the needle's radius of it), so within that of
-// its bounding sphere; the footprint's width is bounded at twice the sphere's far side.
-double nearestFragment(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius)
+// No fragment of a primitive lies nearer along the ray than its ball's bound: a bough's
+// fragments lie within its cones' reach R plus the needles' radius of its axis (base to the
+// cones' end), a branch's within its radius, and each of them within half the footprint of
+// that (nearestAlong).
+double nearestFragment(const ConeRay& ray, const TracedScene& scene, std::uint32_t index)
 {
-    const double centre = glm::dot(0.5 * (a + b) - ray.origin, ray.direction);
-    const double reach = 0.5 * glm::length(b - a) + radius;
-    return centre - reach - ray.width(std::max(0.0, centre + reach));
+    if (scene.isBranch(index)) {
+        const TracedBranch& br = scene.branches[index];
+        return nearestAlong(ray, cylinderSphere(br.base_cm, br.tip_cm, br.radius_cm));
+    }
+    const TracedBough& b = scene.bough(index);
+    return nearestAlong(ray, cylinderSphere(b.base_cm, b.conesEnd_cm,
+                                            b.radius_cm + b.geometry.cone.needleRadius_cm));
 }
 
 void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
 {
     // Front to back: each primitive's fragments are made (and lit, shadow cones and all) only
     // if the composite is not yet opaque at the nearest depth they can lie at, so that what
-    // lies behind opaque layers costs nothing. The composite receives the same fragments in
-    // the same order as if all were made and sorted.
+    // lies behind opaque layers costs nothing; the BVH yields the primitives in that order,
+    // so that it is not walked behind them either. The composite receives the same fragments
+    // in the same order as if all were made and sorted.
     double tGround;
     Vec3 normal;
     const bool hasGround = hitGround(mScene.scene->ground, ray, tGround, normal);
     const double tMax = hasGround ? tGround : std::numeric_limits<double>::infinity();
-    mCandidates.clear();
-    mScene.bvh.query(ray, tMax, [&](std::uint32_t index) {
-        double nearest;
-        if (mScene.isBranch(index)) {
-            const TracedBranch& br = mScene.branches[index];
-            nearest = nearestFragment(ray, br.base_cm, br.tip_cm, br.radius_cm);
-        } else {
-            const TracedBough& b = mScene.bough(index);
-            nearest = nearestFragment(ray, b.base_cm, b.conesEnd_cm,
-                                      b.radius_cm + b.geometry.cone.needleRadius_cm);
-        }
-        mCandidates.push_back({nearest, index});
-    });
-    if (hasGround) mCandidates.push_back({tGround, kGround});
-    std::sort(mCandidates.begin(), mCandidates.end(),
-              [](const Candidate& x, const Candidate& y) {
-                  return x.nearest < y.nearest || (x.nearest == y.nearest && x.index < y.index);
-              });
+    mQueue.clear();
+    if (hasGround) mQueue.add(tGround, kGround);
     mFragments.clear();
     std::size_t done = 0, sorted = 0;  // of mFragments: composited, and sorted by depth
     // Composites the fragments made so far that lie before `depth`: none made later can.
@@ -533,18 +518,22 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
             composite.add(mFragments[done++]);
         }
     };
-    for (const Candidate& c : mCandidates) {
-        compositeBefore(c.nearest);
-        if (composite.opaque()) return;
-        if (c.index == kGround) {
-            mFragments.push_back(mSurfaces.groundAt(ray, tGround, normal));
-        } else if (!mScene.isBranch(c.index)) {
-            addBough(ray, c.index);
-        } else {
-            Fragment f;
-            if (mSurfaces.branch(ray, c.index, tMax, f)) mFragments.push_back(f);
-        }
-    }
+    mScene.bvh.nearestFirst(
+        ray, tMax, mQueue,
+        [&](std::uint32_t index) { return nearestFragment(ray, mScene, index); },
+        [&](std::uint32_t index, double nearest) {
+            compositeBefore(nearest);
+            if (composite.opaque()) return false;
+            if (index == kGround) {
+                mFragments.push_back(mSurfaces.groundAt(ray, tGround, normal));
+            } else if (!mScene.isBranch(index)) {
+                addBough(ray, index);
+            } else {
+                Fragment f;
+                if (mSurfaces.branch(ray, index, tMax, f)) mFragments.push_back(f);
+            }
+            return true;
+        });
     compositeBefore(std::numeric_limits<double>::infinity());
 }
 

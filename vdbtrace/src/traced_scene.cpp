@@ -286,15 +286,19 @@ std::vector<std::string> barkNames() { return barks().names(); }
 void indexPrimitives(TracedScene& scene)
 {
     std::vector<Aabb> boxes;
+    std::vector<Sphere> balls;  // what the multiscale tracer bounds its fragments by
     boxes.reserve(scene.branches.size() + scene.boughs.size());
+    balls.reserve(boxes.capacity());
     for (const TracedBranch& b : scene.branches) {
         boxes.push_back(cylinderBounds(b.base_cm, b.tip_cm, b.radius_cm));
+        balls.push_back(cylinderSphere(b.base_cm, b.tip_cm, b.radius_cm));
     }
     for (const TracedBough& b : scene.boughs) {
-        boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm,
-                                       b.radius_cm + b.geometry.cone.needleRadius_cm));
+        const double radius = b.radius_cm + b.geometry.cone.needleRadius_cm;
+        boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm, radius));
+        balls.push_back(cylinderSphere(b.base_cm, b.conesEnd_cm, radius));
     }
-    scene.bvh = Bvh(boxes);
+    scene.bvh = Bvh(boxes, balls);
 }
 
 TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts& parts)

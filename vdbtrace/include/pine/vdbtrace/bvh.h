@@ -1,6 +1,8 @@
 // A bounding volume hierarchy over boxes (median split), queried by cone rays: each box is
 // grown by the footprint's half-width at its far side, so no primitive the cone touches is
-// missed.
+// missed. Each node also holds a ball about its box's centre holding its primitives' balls,
+// so that a front-to-back query can visit them nearest first and stop where the pixel is
+// opaque, never reaching what lies behind.
 #pragma once
 
 #include "pine/vdbtrace/geometry.h"
@@ -15,10 +17,50 @@
 
 namespace pine::vdbtrace {
 
+/// What Bvh::nearestFirst has still to visit, kept by its caller so that no query allocates.
+class NearestFirstQueue {
+public:
+    void clear() { mHeap.clear(); }
+    /// A primitive of the caller's own (not in the BVH), visited in its turn.
+    void add(double nearest, std::uint32_t index) { push({nearest, index, true}); }
+
+private:
+    friend class Bvh;
+    struct Entry {
+        double nearest;
+        std::uint32_t index;  ///< a node or a primitive
+        bool primitive;
+    };
+    // Visited later: farther, or as near and a primitive where the other is a node (whose
+    // primitives may be as near), or of a larger index.
+    static bool later(const Entry& a, const Entry& b)
+    {
+        if (a.nearest != b.nearest) return a.nearest > b.nearest;
+        if (a.primitive != b.primitive) return a.primitive;
+        return a.index > b.index;
+    }
+    void push(const Entry& e)
+    {
+        mHeap.push_back(e);
+        std::push_heap(mHeap.begin(), mHeap.end(), later);
+    }
+    Entry pop()
+    {
+        std::pop_heap(mHeap.begin(), mHeap.end(), later);
+        const Entry e = mHeap.back();
+        mHeap.pop_back();
+        return e;
+    }
+    std::vector<Entry> mHeap;
+};
+
 class Bvh {
 public:
     Bvh() = default;
+    /// Each primitive's ball is its box's circumscribed one.
     explicit Bvh(const std::vector<Aabb>& boxes);
+    /// `balls[i]` holds what primitive i's nearest-first bound is taken over (nearestFirst).
+    Bvh(const std::vector<Aabb>& boxes, const std::vector<Sphere>& balls);
 
     /// Calls visit(index) for every primitive whose box the cone may touch before tMax, in a
     /// fixed order. A visit that returns bool ends the query by returning false.
@@ -49,6 +91,43 @@ public:
         }
     }
 
+    /// Calls visit(index, nearest) for the primitives query(ray, tMax) would visit and those
+    /// added to `queue` beforehand, in increasing order of nearest = nearestOf(index) (then of
+    /// index), until visit returns false. nearestOf must bound no lower than
+    /// nearestAlong(ray, ball) of the primitive's ball: then no primitive that comes later
+    /// has a smaller bound, and the order is the one sorting them all would give.
+    template <class NearestOf, class Visit>
+    void nearestFirst(const ConeRay& ray, double tMax, NearestFirstQueue& queue,
+                      NearestOf&& nearestOf, Visit&& visit) const
+    {
+        const Slabs slabs(ray);
+        const auto pushNode = [&](std::uint32_t index) {
+            const Node& node = mNodes[index];
+            if (slabs.meets(ray, node, tMax)) {
+                queue.push({nearestAlong(ray, Sphere{node.centre, node.ballRadius}), index,
+                            false});
+            }
+        };
+        if (!mNodes.empty()) pushNode(0);
+        while (!queue.mHeap.empty()) {
+            const NearestFirstQueue::Entry e = queue.pop();
+            if (e.primitive) {
+                if (!visit(e.index, e.nearest)) return;
+                continue;
+            }
+            const Node& node = mNodes[e.index];
+            if (node.count > 0) {
+                for (std::uint32_t i = 0; i < node.count; ++i) {
+                    const std::uint32_t index = mIndices[node.first + i];
+                    queue.push({nearestOf(index), index, true});
+                }
+            } else {
+                pushNode(node.first);
+                pushNode(node.first + 1);
+            }
+        }
+    }
+
     const Aabb& bounds() const { return mNodes.front().box; }
     bool empty() const { return mNodes.empty(); }
 
@@ -57,6 +136,7 @@ private:
         Aabb box;
         Vec3 centre{0.0};           ///< of the box
         double halfDiagonal = 0.0;  ///< of the box
+        double ballRadius = 0.0;    ///< about the centre, holding the primitives' balls
         std::uint32_t first = 0;    ///< leaf: first index; inner: first child
         std::uint32_t count = 0;    ///< leaf: number of primitives; inner: 0
     };
@@ -94,8 +174,8 @@ private:
             return true;
         }
     };
-    void build(const std::vector<Aabb>& boxes, std::uint32_t node, std::uint32_t first,
-               std::uint32_t count);
+    void build(const std::vector<Aabb>& boxes, const std::vector<Sphere>& balls,
+               std::uint32_t node, std::uint32_t first, std::uint32_t count);
 
     std::vector<Node> mNodes;
     std::vector<std::uint32_t> mIndices;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include <algorithm>
@@ -31,6 +32,28 @@ struct Aabb {
 
 /// Box of a cylinder (segment a-b, radius r), conservatively.
 Aabb cylinderBounds(const Vec3& a, const Vec3& b, double radius);
+
+/// A ball holding a primitive (or a node's primitives' balls).
+struct Sphere {
+    Vec3 centre{0.0};
+    double radius = 0.0;
+};
+
+/// The ball about a cylinder's middle reaching its ends' rims (segment a-b, radius r).
+inline Sphere cylinderSphere(const Vec3& a, const Vec3& b, double radius)
+{
+    return {0.5 * (a + b), 0.5 * glm::length(b - a) + radius};
+}
+
+/// No point of the ball that the cone ray touches lies nearer along the ray than this: the
+/// ball's near side, less the footprint's width at its far side (a bound on the half-width
+/// any point the footprint touches lies off the ray's axis). It is monotone in the ball: a
+/// ball inside another gets no smaller a bound, so a node's bound holds for its primitives.
+inline double nearestAlong(const ConeRay& ray, const Sphere& ball)
+{
+    const double centre = glm::dot(ball.centre - ray.origin, ray.direction);
+    return centre - ball.radius - ray.width(std::max(0.0, centre + ball.radius));
+}
 
 /// Where a cone ray passes a finite thin cylinder (segment a-b, radius r): closest approach of
 /// the ray's axis to the cylinder's, its distance `t` along the ray, the distance `gap` between
