@@ -197,6 +197,7 @@ public:
                 double T = 1.0;
                 layers.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
                     T *= 1.0 - hit.opacity;
+                    return T > 0.0;  // none further changes it
                 });
                 cells[k] += (1.0 - T) * weight;
             }
@@ -259,11 +260,11 @@ private:
                 const double tMid = 0.5 * (tIn + tOut);
                 double T = 1.0;
                 layers.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
-                    if (T < kOpaque) return;
                     const double share = T * hit.opacity;  // what this layer shows
                     T *= 1.0 - hit.opacity;
                     visit(ShownLayer{hit.t < tMid ? 0 : 1, k, share * weight, o + hit.t * d,
                                      hit.cone});
+                    return T >= kOpaque;
                 });
             }
         }

@@ -79,11 +79,10 @@ public:
     explicit FibreLayerModel(bool correlated) : mCorrelated(correlated) {}
 
     void layers(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn, double tOut,
-                const std::function<void(const LayerHit&)>& visit) const override
+                const std::function<bool(const LayerHit&)>& visit) const override
     {
         forEachConeBand(b, o, d, tIn, tOut, [&](const ConeBand& band) {
-            visit(LayerHit{band.cone, band.t, std::min(1.0, band.needles)});
-            return true;
+            return visit(LayerHit{band.cone, band.t, std::min(1.0, band.needles)});
         });
     }
 

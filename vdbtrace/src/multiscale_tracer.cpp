@@ -268,7 +268,10 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
         // composites.
         mLayerHits.clear();
         mScene.layers->layers(b, ray.origin, ray.direction, tIn, tOut,
-                              [&](const LayerHit& hit) { mLayerHits.push_back(hit); });
+                              [&](const LayerHit& hit) {
+                                  mLayerHits.push_back(hit);
+                                  return true;
+                              });
         std::stable_sort(mLayerHits.begin(), mLayerHits.end(),
                          [](const LayerHit& x, const LayerHit& y) { return x.t < y.t; });
         double covered = 0.0;  // by this bough's layers in front, of the footprint

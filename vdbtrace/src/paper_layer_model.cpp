@@ -14,10 +14,10 @@ namespace {
 class PaperLayerModel final : public LayerModel {
 public:
     void layers(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn, double tOut,
-                const std::function<void(const LayerHit&)>& visit) const override
+                const std::function<bool(const LayerHit&)>& visit) const override
     {
         forEachConeCrossing(b, o, d, tIn, tOut, [&](long j, double t) {
-            visit(LayerHit{j, t, b.layerOpacity});
+            return visit(LayerHit{j, t, b.layerOpacity});
         });
     }
 

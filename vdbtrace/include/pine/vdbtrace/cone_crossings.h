@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace pine::vdbtrace {
 
@@ -51,7 +52,8 @@ inline bool insideBark(const TracedBough& b, const Vec3& x)
 /// Calls visit(j, t) for every crossing of cone j in [0, floor(length / dh)] by the line
 /// o + t d, t in [tIn, tOut], in order: the march moves g by at most dh / 4 a step (|dg/dt|
 /// <= 1 + cot(phi)) and places each crossing by linear interpolation within its step.
-/// Crossings inside the bark (insideBark) are not visited.
+/// Crossings inside the bark (insideBark) are not visited. A visit that returns bool ends
+/// the walk by returning false.
 template <class Visit>
 void forEachConeCrossing(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn,
                          double tOut, Visit&& visit)
@@ -69,7 +71,11 @@ void forEachConeCrossing(const TracedBough& b, const Vec3& o, const Vec3& d, dou
             if (j < 0 || j > jMax) continue;
             const double t = t0 + (double(j) * dh - g0) / (g1 - g0) * (t1 - t0);
             if (insideBark(b, o + t * d)) continue;  // hidden
-            visit(j, t);
+            if constexpr (std::is_same_v<std::invoke_result_t<Visit, long, double>, bool>) {
+                if (!visit(j, t)) return;
+            } else {
+                visit(j, t);
+            }
         }
         t0 = t1;
         g0 = g1;

@@ -23,10 +23,11 @@ class LayerModel {
 public:
     virtual ~LayerModel() = default;
     /// Calls visit for every layer of b that the line o + t d (d unit) meets for t in
-    /// [tIn, tOut]; each layer's needles are independent of every other layer's (each cone has
-    /// its own roll, needle_layout.h).
+    /// [tIn, tOut], until it returns false (a line gone opaque needs no more); each layer's
+    /// needles are independent of every other layer's (each cone has its own roll,
+    /// needle_layout.h).
     virtual void layers(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn,
-                        double tOut, const std::function<void(const LayerHit&)>& visit) const = 0;
+                        double tOut, const std::function<bool(const LayerHit&)>& visit) const = 0;
     /// The light that reaches x on a needle of cone `ownCone` from unit direction
     /// `towardsLight` through b's other layers (section 6's self-shadowing, counted), for a
     /// needle seen from unit direction `towardsViewer` through b's layers in front of it (a
