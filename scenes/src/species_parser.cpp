@@ -103,6 +103,16 @@ NeedleParameters readNeedles(const Json& value, const Where& where,
         where.key("radius").fail("must be less than the needle length (" +
                                  formatNumber(p.length_cm) + " cm)");
     }
+    // A line across a bough crosses about 2 l / dh layers; the multiscale levels walk them one
+    // by one (cone_crossings.h), so a spacing far below any fir's is refused before any work.
+    constexpr double kMaxLayersAcross = 20000.0;
+    if (2.0 * p.length_cm / p.coneSpacing_cm > kMaxLayersAcross) {
+        where.key("cone_spacing")
+            .fail("must be at least 2 x the needle length / " +
+                  formatNumber(kMaxLayersAcross) + " (" +
+                  formatNumber(2.0 * p.length_cm / kMaxLayersAcross) +
+                  " cm): a line through a bough would cross more layers than that");
+    }
     // Section 3.3: A = 2 N r / (pi R) is the fraction of the cone covered by needles; above 1
     // the needles of one cone overlap and no shader level describes them.
     const double A = analytic::layerCoverage(

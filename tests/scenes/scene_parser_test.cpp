@@ -584,6 +584,12 @@ TEST(SceneParser, RejectsNeedlesThatCannotExist)
     j["species"]["fir"]["needles"]["tip"]["per_cone"] = 40;
     j["species"]["fir"]["needles"]["tip"]["radius"] = 0.2;
     expectError(j, "species.fir.needles.tip", "needles overlap");
+    // Cones 1e-6 cm apart: a line through a bough would cross millions of layers.
+    j = fullScene();
+    j["species"]["fir"]["needles"]["base"]["cone_spacing"] = 1e-6;
+    expectError(j, "species.fir.needles.base.cone_spacing", "more layers");
+    j["species"]["fir"]["needles"]["base"]["cone_spacing"] = 0.01;  // a thousand: kept
+    EXPECT_NO_THROW(parseScene(j.dump(), "dense-cones.json"));
 }
 
 TEST(SceneParser, RejectsAHeightForATreeThatGrowsNone)
