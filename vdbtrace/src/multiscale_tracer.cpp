@@ -93,7 +93,12 @@ private:
     RenderStats& mStats;
     SurfaceShading mSurfaces;
     std::vector<Fragment> mFragments;
+    std::vector<std::pair<double, std::uint32_t>> mMadeBy;  ///< per fragment: its primitive's
+                                                            ///< bound and index
+    std::vector<std::size_t> mOrder;  ///< mFragments' indices, composited first
     static constexpr std::uint32_t kGround = std::uint32_t(-1);  ///< in mQueue
+    /// In mQueue, with a bough's index: the bough queued again at its entry (boughEntry).
+    static constexpr std::uint32_t kAtEntry = std::uint32_t(1) << 31;
     NearestFirstQueue mQueue;  ///< the primitives the ray may yet meet
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
@@ -494,6 +499,22 @@ double nearestFragment(const ConeRay& ray, const TracedScene& scene, std::uint32
                                             b.radius_cm + b.geometry.cone.needleRadius_cm));
 }
 
+// No fragment of bough b lies nearer along the ray than this, tighter than its ball's bound
+// for a bough seen side-on: its needles lie within its cones' reach R of the axis, base to
+// the cones' end (and level 3's strip within that), grown by a needle's radius, and each
+// fragment within half the footprint of them (its width at `far`, beyond any fragment).
+// -infinity where the ray misses that cylinder.
+double boughEntry(const ConeRay& ray, const TracedBough& b, double far)
+{
+    const double reach =
+        b.radius_cm + b.geometry.cone.needleRadius_cm + 0.5 * ray.width(far);
+    double tIn, tOut;
+    if (!intersectCylinder(ray, b.base_cm, b.conesEnd_cm, reach, tIn, tOut)) {
+        return -std::numeric_limits<double>::infinity();
+    }
+    return tIn - 1e-9 * (1.0 + std::abs(tIn));  // below rounding
+}
+
 void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
 {
     // Front to back: each primitive's fragments are made (and lit, shadow cones and all) only
@@ -508,18 +529,31 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     mQueue.clear();
     if (hasGround) mQueue.add(tGround, kGround);
     mFragments.clear();
-    std::size_t done = 0, sorted = 0;  // of mFragments: composited, and sorted by depth
+    mMadeBy.clear();
+    mOrder.clear();
+    // Fragments at one depth (a grazing bough's halves and the branch inside it meet the ray
+    // at one closest passage) composite in the order of their primitives' bounds, then as
+    // made: the order of the primitives sorted by their bounds, whenever each was shaded.
+    const auto before = [&](std::size_t i, std::size_t j) {
+        if (mFragments[i].t != mFragments[j].t) return mFragments[i].t < mFragments[j].t;
+        if (mMadeBy[i] != mMadeBy[j]) return mMadeBy[i] < mMadeBy[j];
+        return i < j;
+    };
+    std::size_t done = 0;  // of mOrder: composited
     // Composites the fragments made so far that lie before `depth`: none made later can.
     const auto compositeBefore = [&](double depth) {
-        if (sorted != mFragments.size()) {
-            std::stable_sort(mFragments.begin() + done, mFragments.end(),
-                             [](const Fragment& a, const Fragment& b) { return a.t < b.t; });
-            sorted = mFragments.size();
+        if (mOrder.size() != mFragments.size()) {
+            for (std::size_t i = mOrder.size(); i < mFragments.size(); ++i) mOrder.push_back(i);
+            std::sort(mOrder.begin() + long(done), mOrder.end(), before);
         }
-        while (done < mFragments.size() && mFragments[done].t <= depth &&
+        while (done < mOrder.size() && mFragments[mOrder[done]].t <= depth &&
                !composite.opaque()) {
-            composite.add(mFragments[done++]);
+            composite.add(mFragments[mOrder[done++]]);
         }
+    };
+    // Those made since, by primitive `index` of bound `nearest`.
+    const auto madeBy = [&](double nearest, std::uint32_t index) {
+        mMadeBy.resize(mFragments.size(), {nearest, index});
     };
     mScene.bvh.nearestFirst(
         ray, tMax, mQueue,
@@ -529,11 +563,31 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
             if (composite.opaque()) return false;
             if (index == kGround) {
                 mFragments.push_back(mSurfaces.groundAt(ray, tGround, normal));
-            } else if (!mScene.isBranch(index)) {
+                madeBy(nearest, index);
+            } else if (index & kAtEntry) {
+                index &= ~kAtEntry;
                 addBough(ray, index);
+                madeBy(nearestFragment(ray, mScene, index), index);
+            } else if (!mScene.isBranch(index)) {
+                // Queued again at where its fragments can begin, a bough is shaded (its law's
+                // profiles, its shadow cones) only if the pixel is not opaque there: the
+                // fragments of boughs nearer it may hide it whole.
+                const TracedBough& b = mScene.bough(index);
+                const Sphere ball = cylinderSphere(b.base_cm, b.conesEnd_cm,
+                                                   b.radius_cm + b.geometry.cone.needleRadius_cm);
+                const double far = (glm::dot(ball.centre - ray.origin, ray.direction) +
+                                    ball.radius) / std::max(1e-9, 1.0 - 0.5 * ray.spread);
+                const double entry = boughEntry(ray, b, far);
+                if (entry > nearest) {
+                    mQueue.add(entry, index | kAtEntry);
+                } else {
+                    addBough(ray, index);
+                    madeBy(nearest, index);
+                }
             } else {
                 Fragment f;
                 if (mSurfaces.branch(ray, index, tMax, f)) mFragments.push_back(f);
+                madeBy(nearest, index);
             }
             return true;
         });

@@ -285,6 +285,10 @@ std::vector<std::string> barkNames() { return barks().names(); }
 
 void indexPrimitives(TracedScene& scene)
 {
+    // The multiscale tracer flags a bough's index with the top bit of 32 (kAtEntry).
+    if (scene.branches.size() + scene.boughs.size() >= (std::size_t(1) << 31)) {
+        throw std::length_error("more than 2^31 branches and boughs to index");
+    }
     std::vector<Aabb> boxes;
     std::vector<Sphere> balls;  // what the multiscale tracer bounds its fragments by
     boxes.reserve(scene.branches.size() + scene.boughs.size());
