@@ -490,13 +490,7 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
 // that (nearestAlong).
 double nearestFragment(const ConeRay& ray, const TracedScene& scene, std::uint32_t index)
 {
-    if (scene.isBranch(index)) {
-        const TracedBranch& br = scene.branches[index];
-        return nearestAlong(ray, cylinderSphere(br.base_cm, br.tip_cm, br.radius_cm));
-    }
-    const TracedBough& b = scene.bough(index);
-    return nearestAlong(ray, cylinderSphere(b.base_cm, b.conesEnd_cm,
-                                            b.radius_cm + b.geometry.cone.needleRadius_cm));
+    return nearestAlong(ray, primitiveBall(scene, index));
 }
 
 // No fragment of bough b lies nearer along the ray than this, tighter than its ball's bound
@@ -572,12 +566,10 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
                 // Queued again at where its fragments can begin, a bough is shaded (its law's
                 // profiles, its shadow cones) only if the pixel is not opaque there: the
                 // fragments of boughs nearer it may hide it whole.
-                const TracedBough& b = mScene.bough(index);
-                const Sphere ball = cylinderSphere(b.base_cm, b.conesEnd_cm,
-                                                   b.radius_cm + b.geometry.cone.needleRadius_cm);
+                const Sphere ball = primitiveBall(mScene, index);
                 const double far = (glm::dot(ball.centre - ray.origin, ray.direction) +
                                     ball.radius) / std::max(1e-9, 1.0 - 0.5 * ray.spread);
-                const double entry = boughEntry(ray, b, far);
+                const double entry = boughEntry(ray, mScene.bough(index), far);
                 if (entry > nearest) {
                     mQueue.add(entry, index | kAtEntry);
                 } else {

@@ -283,6 +283,17 @@ std::vector<std::string> shadowOriginNames() { return shadowOrigins().names(); }
 
 std::vector<std::string> barkNames() { return barks().names(); }
 
+Sphere primitiveBall(const TracedScene& scene, std::size_t primitive)
+{
+    if (scene.isBranch(primitive)) {
+        const TracedBranch& b = scene.branches[primitive];
+        return cylinderSphere(b.base_cm, b.tip_cm, b.radius_cm);
+    }
+    const TracedBough& b = scene.bough(primitive);
+    return cylinderSphere(b.base_cm, b.conesEnd_cm,
+                          b.radius_cm + b.geometry.cone.needleRadius_cm);
+}
+
 void indexPrimitives(TracedScene& scene)
 {
     // The multiscale tracer flags a bough's index with the top bit of 32 (kAtEntry).
@@ -290,18 +301,17 @@ void indexPrimitives(TracedScene& scene)
         throw std::length_error("more than 2^31 branches and boughs to index");
     }
     std::vector<Aabb> boxes;
-    std::vector<Sphere> balls;  // what the multiscale tracer bounds its fragments by
+    std::vector<Sphere> balls;
     boxes.reserve(scene.branches.size() + scene.boughs.size());
     balls.reserve(boxes.capacity());
     for (const TracedBranch& b : scene.branches) {
         boxes.push_back(cylinderBounds(b.base_cm, b.tip_cm, b.radius_cm));
-        balls.push_back(cylinderSphere(b.base_cm, b.tip_cm, b.radius_cm));
     }
     for (const TracedBough& b : scene.boughs) {
-        const double radius = b.radius_cm + b.geometry.cone.needleRadius_cm;
-        boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm, radius));
-        balls.push_back(cylinderSphere(b.base_cm, b.conesEnd_cm, radius));
+        boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm,
+                                       b.radius_cm + b.geometry.cone.needleRadius_cm));
     }
+    for (std::size_t i = 0; i < boxes.size(); ++i) balls.push_back(primitiveBall(scene, i));
     scene.bvh = Bvh(boxes, balls);
 }
 
