@@ -97,7 +97,7 @@ private:
                                                             ///< bound and index
     std::vector<std::size_t> mOrder;  ///< mFragments' indices, composited first
     static constexpr std::uint32_t kGround = std::uint32_t(-1);  ///< in mQueue
-    /// In mQueue, with a bough's index: the bough queued again at its entry (boughEntry).
+    /// In mQueue, with a primitive's index: queued again at its entry (primitiveEntry).
     static constexpr std::uint32_t kAtEntry = std::uint32_t(1) << 31;
     NearestFirstQueue mQueue;  ///< the primitives the ray may yet meet
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
@@ -493,17 +493,29 @@ double nearestFragment(const ConeRay& ray, const TracedScene& scene, std::uint32
     return nearestAlong(ray, primitiveBall(scene, index));
 }
 
-// No fragment of bough b lies nearer along the ray than this, tighter than its ball's bound
-// for a bough seen side-on: its needles lie within its cones' reach R of the axis, base to
-// the cones' end (and level 3's strip within that), grown by a needle's radius, and each
-// fragment within half the footprint of them (its width at `far`, beyond any fragment).
-// -infinity where the ray misses that cylinder.
-double boughEntry(const ConeRay& ray, const TracedBough& b, double far)
+// No fragment of a primitive lies nearer along the ray than this, tighter than its ball's
+// bound for a primitive seen side-on: a bough's needles lie within its cones' reach R of the
+// axis, base to the cones' end (and level 3's strip within that), grown by a needle's
+// radius; a branch's cylinder is itself; each fragment lies within half the footprint of
+// them (its width at the ball's far side, beyond any fragment). -infinity where the ray
+// misses that cylinder.
+double primitiveEntry(const ConeRay& ray, const TracedScene& scene, std::uint32_t index)
 {
-    const double reach =
-        b.radius_cm + b.geometry.cone.needleRadius_cm + 0.5 * ray.width(far);
+    const Sphere ball = primitiveBall(scene, index);
+    const double far = (glm::dot(ball.centre - ray.origin, ray.direction) + ball.radius) /
+                       std::max(1e-9, 1.0 - 0.5 * ray.spread);
+    Vec3 a, b;
+    double radius;
+    if (scene.isBranch(index)) {
+        const TracedBranch& br = scene.branches[index];
+        a = br.base_cm, b = br.tip_cm, radius = br.radius_cm;
+    } else {
+        const TracedBough& bough = scene.bough(index);
+        a = bough.base_cm, b = bough.conesEnd_cm;
+        radius = bough.radius_cm + bough.geometry.cone.needleRadius_cm;
+    }
     double tIn, tOut;
-    if (!intersectCylinder(ray, b.base_cm, b.conesEnd_cm, reach, tIn, tOut)) {
+    if (!intersectCylinder(ray, a, b, radius + 0.5 * ray.width(far), tIn, tOut)) {
         return -std::numeric_limits<double>::infinity();
     }
     return tIn - 1e-9 * (1.0 + std::abs(tIn));  // below rounding
@@ -558,29 +570,29 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
             if (index == kGround) {
                 mFragments.push_back(mSurfaces.groundAt(ray, tGround, normal));
                 madeBy(nearest, index);
-            } else if (index & kAtEntry) {
-                index &= ~kAtEntry;
-                addBough(ray, index);
-                madeBy(nearestFragment(ray, mScene, index), index);
-            } else if (!mScene.isBranch(index)) {
-                // Queued again at where its fragments can begin, a bough is shaded (its law's
-                // profiles, its shadow cones) only if the pixel is not opaque there: the
-                // fragments of boughs nearer it may hide it whole.
-                const Sphere ball = primitiveBall(mScene, index);
-                const double far = (glm::dot(ball.centre - ray.origin, ray.direction) +
-                                    ball.radius) / std::max(1e-9, 1.0 - 0.5 * ray.spread);
-                const double entry = boughEntry(ray, mScene.bough(index), far);
+                return true;
+            }
+            const bool atEntry = index & kAtEntry;
+            index &= ~kAtEntry;
+            if (!atEntry) {
+                // Queued again at where its fragments can begin, a primitive is shaded (a
+                // bough's law's profiles, every shadow cone) only if the pixel is not opaque
+                // there: the fragments of those nearer it may hide it whole.
+                const double entry = primitiveEntry(ray, mScene, index);
                 if (entry > nearest) {
                     mQueue.add(entry, index | kAtEntry);
-                } else {
-                    addBough(ray, index);
-                    madeBy(nearest, index);
+                    return true;
                 }
+            } else {
+                nearest = nearestFragment(ray, mScene, index);
+            }
+            if (!mScene.isBranch(index)) {
+                addBough(ray, index);
             } else {
                 Fragment f;
                 if (mSurfaces.branch(ray, index, tMax, f)) mFragments.push_back(f);
-                madeBy(nearest, index);
             }
+            madeBy(nearest, index);
             return true;
         });
     compositeBefore(std::numeric_limits<double>::infinity());
