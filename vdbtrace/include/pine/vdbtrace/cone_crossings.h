@@ -113,7 +113,7 @@ public:
     }
     double along() const { return mAlong; }  ///< d . axis
     double rho(double t) const { return std::sqrt(std::max(0.0, mQ0 + t * (2.0 * mQ1 + t * mQ2))); }
-    /// d . (the point's offset from the axis), over rho: the radial part of d.
+    /// d . (the point's offset from the axis): rho times the radial part of d.
     double radialRate(double t) const { return mQ1 + mQ2 * t; }
     double g(double t) const { return mH0 + t * mAlong - rho(t) * mCotPhi; }
     /// Where the line passes the axis closest, and where it is `rho` from the axis (false if
@@ -194,9 +194,10 @@ private:
 /// A band ends where g crosses a band's edge (g = (j +- 1/2) dh, in closed form) and where g
 /// turns (ConeLine), so that a line crossing a cone twice meets its needles twice; sigma is
 /// integrated over each band by two-point Gauss-Legendre panels a quarter of a band's g
-/// apart at the steepest, finer near the axis (tested against a fine march). Inside the bark (insideBark) the
-/// needles' roots are hidden: nothing is counted within it, unless !hiddenInBark (level 1
-/// looks for whole needles, whose roots the branch's own fragment hides).
+/// apart at the steepest, finer near the axis (tested against a fine march). Inside the bark
+/// (insideBark) the needles' roots are hidden: nothing is counted within it, unless
+/// !hiddenInBark (level 1 looks for whole needles, whose roots the branch's own fragment
+/// hides).
 template <class Visit>
 void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn, double tOut,
                      Visit&& visit, bool hiddenInBark = true)
