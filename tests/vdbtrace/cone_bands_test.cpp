@@ -1,11 +1,10 @@
 // The bands of a line through a bough's cones (cone_crossings.h) against a fine march of their
 // own definition: g = h - rho cot(phi) walked in small steps (256 to the old march's one),
 // each step's needles (sigma's trapezoid) given to the band g lies in, a band ending where g
-// crosses an edge or turns. The
-// closed form (ConeLine's levels and turn, Gauss-Legendre panels) must give the same bands,
-// needles and mean depths over random lines through a paper bough with a solid branch: grazing
-// lines, lines through the axis, along it, along the cones' generators, and lines that start
-// inside the bark.
+// crosses an edge or turns. The closed form (ConeLine's levels and turn, Gauss-Legendre
+// panels) must give the same bands, needles and mean depths over random lines through a paper
+// bough with a solid branch: grazing lines, lines through the axis, along it, along the cones'
+// generators, and lines that start inside the bark.
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/traced_scene.h"
