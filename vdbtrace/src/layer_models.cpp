@@ -28,12 +28,8 @@ const Registry<LayerModel>& registry(bool correlated)
 
 const Registry<const bool>& correlations()
 {
-    static const Registry<const bool> r = [] {
-        Registry<const bool> out("layer correlation");
-        out.add("needles", std::make_unique<const bool>(true));
-        out.add("independent", std::make_unique<const bool>(false));
-        return out;
-    }();
+    static const Registry<const bool> r =
+        namedSwitch("layer correlation", "needles", "independent");
     return r;
 }
 

@@ -268,12 +268,7 @@ const Registry<const ShadowOrigin>& shadowOrigins()
 // render.bark: whether a bough's needles have their roots in a solid branch.
 const Registry<const bool>& barks()
 {
-    static const Registry<const bool> solid = [] {
-        Registry<const bool> r("bark");
-        r.add("solid", std::make_unique<const bool>(true));
-        r.add("line", std::make_unique<const bool>(false));
-        return r;
-    }();
+    static const Registry<const bool> solid = namedSwitch("bark", "solid", "line");
     return solid;
 }
 
@@ -283,35 +278,38 @@ std::vector<std::string> shadowOriginNames() { return shadowOrigins().names(); }
 
 std::vector<std::string> barkNames() { return barks().names(); }
 
-Sphere primitiveBall(const TracedScene& scene, std::size_t primitive)
+PrimitiveCylinder primitiveCylinder(const TracedScene& scene, std::size_t primitive)
 {
     if (scene.isBranch(primitive)) {
         const TracedBranch& b = scene.branches[primitive];
-        return cylinderSphere(b.base_cm, b.tip_cm, b.radius_cm);
+        return {b.base_cm, b.tip_cm, b.radius_cm};
     }
     const TracedBough& b = scene.bough(primitive);
-    return cylinderSphere(b.base_cm, b.conesEnd_cm,
-                          b.radius_cm + b.geometry.cone.needleRadius_cm);
+    return {b.base_cm, b.conesEnd_cm, b.radius_cm + b.geometry.cone.needleRadius_cm};
+}
+
+Sphere primitiveBall(const TracedScene& scene, std::size_t primitive)
+{
+    const PrimitiveCylinder c = primitiveCylinder(scene, primitive);
+    return cylinderSphere(c.base, c.end, c.radius_cm);
 }
 
 void indexPrimitives(TracedScene& scene)
 {
-    // The multiscale tracer flags a bough's index with the top bit of 32 (kAtEntry).
+    // The multiscale tracer flags a primitive's index with the top bit of 32 (kAtEntry).
     if (scene.branches.size() + scene.boughs.size() >= (std::size_t(1) << 31)) {
         throw std::length_error("more than 2^31 branches and boughs to index");
     }
+    const std::size_t count = scene.branches.size() + scene.boughs.size();
     std::vector<Aabb> boxes;
     std::vector<Sphere> balls;
-    boxes.reserve(scene.branches.size() + scene.boughs.size());
-    balls.reserve(boxes.capacity());
-    for (const TracedBranch& b : scene.branches) {
-        boxes.push_back(cylinderBounds(b.base_cm, b.tip_cm, b.radius_cm));
+    boxes.reserve(count);
+    balls.reserve(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        const PrimitiveCylinder c = primitiveCylinder(scene, i);
+        boxes.push_back(cylinderBounds(c.base, c.end, c.radius_cm));
+        balls.push_back(cylinderSphere(c.base, c.end, c.radius_cm));
     }
-    for (const TracedBough& b : scene.boughs) {
-        boxes.push_back(cylinderBounds(b.base_cm, b.conesEnd_cm,
-                                       b.radius_cm + b.geometry.cone.needleRadius_cm));
-    }
-    for (std::size_t i = 0; i < boxes.size(); ++i) balls.push_back(primitiveBall(scene, i));
     scene.bvh = Bvh(boxes, balls);
 }
 

@@ -51,4 +51,14 @@ private:
     std::vector<Entry> mEntries;
 };
 
+/// A choice between two names (render.bark, render.layer_correlation): `on` (true, the
+/// default) or `off`.
+inline Registry<const bool> namedSwitch(std::string kind, std::string on, std::string off)
+{
+    Registry<const bool> r(std::move(kind));
+    r.add(std::move(on), std::make_unique<const bool>(true));
+    r.add(std::move(off), std::make_unique<const bool>(false));
+    return r;
+}
+
 }  // namespace pine
