@@ -74,6 +74,24 @@ double unionLength(std::vector<std::pair<double, double>>& pieces, const std::ve
     return open ? total + hi - lo : 0.0;
 }
 
+// Calls visit(band) -> bool (false stops) for the bands of the line from x along d (d unit)
+// through b's layers, the band of its own cone that x lies in left out: a needle is not
+// shadowed by the band it lies in.
+template <class Visit>
+void forEachBandFrom(const TracedBough& b, const Vec3& x, const Vec3& d, long ownCone,
+                     Visit&& visit)
+{
+    double tIn, tOut;
+    if (!layeredInterval(b, x, d, tIn, tOut)) return;
+    const bool inside = tIn <= 0.0;
+    bool first = true;
+    forEachConeBand(b, x, d, std::max(tIn, 0.0), tOut, [&](const ConeBand& band) {
+        const bool own = first && inside && band.cone == ownCone;
+        first = false;
+        return own || visit(band);
+    });
+}
+
 class FibreLayerModel final : public LayerModel {
 public:
     explicit FibreLayerModel(bool correlated) : mCorrelated(correlated) {}
@@ -92,39 +110,24 @@ public:
         if (mCorrelated && glm::dot(towardsViewer, towardsViewer) > 0.0) {
             return correlated(b, x, towardsLight, ownCone, towardsViewer);
         }
-        double tIn, tOut;
-        if (!layeredInterval(b, x, towardsLight, tIn, tOut)) return 1.0;
-        const bool inside = tIn <= 0.0;
-        bool first = true;
         double transmittance = 1.0;
-        forEachConeBand(b, x, towardsLight, std::max(tIn, 0.0), tOut, [&](const ConeBand& band) {
-            // A needle is not shadowed by the band of its own cone that it lies in.
-            if (!(first && inside && band.cone == ownCone)) {
-                transmittance *= 1.0 - std::min(1.0, band.needles);
-            }
-            first = false;
+        forEachBandFrom(b, x, towardsLight, ownCone, [&](const ConeBand& band) {
+            transmittance *= 1.0 - std::min(1.0, band.needles);
             return transmittance > 1e-6;
         });
         return transmittance;
     }
 
 private:
-    // The arcs of the line from x along d, the band of its own cone it starts in left out (a
-    // needle is not shadowed by the band it lies in).
+    // The arcs of the line from x along d (forEachBandFrom's bands).
     static void arcsAlong(const TracedBough& b, const Vec3& x, const Vec3& d, long ownCone,
                           double period, std::vector<Arc>& out)
     {
         out.clear();
-        double tIn, tOut;
-        if (!layeredInterval(b, x, d, tIn, tOut)) return;
         const double cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad);
         const Vec3 e1 = analytic::anyPerpendicular(b.axis), e2 = glm::cross(b.axis, e1);
-        const bool inside = tIn <= 0.0;
-        bool first = true;
-        forEachConeBand(b, x, d, std::max(tIn, 0.0), tOut, [&](const ConeBand& band) {
-            const bool start = first && inside && band.cone == ownCone;
-            first = false;
-            if (start || !(band.needles > 0.0)) return true;
+        forEachBandFrom(b, x, d, ownCone, [&](const ConeBand& band) {
+            if (!(band.needles > 0.0)) return true;
             Vec3 radial;
             coneHeight(b, cotPhi, x + band.t * d, nullptr, &radial);
             const double azimuth = std::atan2(glm::dot(radial, e2), glm::dot(radial, e1));
