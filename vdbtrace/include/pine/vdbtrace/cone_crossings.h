@@ -110,6 +110,10 @@ public:
         mQ0 = glm::dot(across0, across0);
         mQ1 = glm::dot(across0, dAcross);
         mQ2 = glm::dot(dAcross, dAcross);
+        if (mQ2 > 1e-24) {  // else along the axis: rho is constant
+            mClosest = -mQ1 / mQ2;
+            mM2 = mQ0 - mQ1 * mQ1 / mQ2;
+        }
     }
     double along() const { return mAlong; }  ///< d . axis
     double rho(double t) const { return std::sqrt(std::max(0.0, mQ0 + t * (2.0 * mQ1 + t * mQ2))); }
@@ -118,15 +122,13 @@ public:
     double g(double t) const { return mH0 + t * mAlong - rho(t) * mCotPhi; }
     /// Where the line passes the axis closest, and where it is `rho` from the axis (false if
     /// never), entering and leaving.
-    double closest() const { return mQ2 > 1e-24 ? -mQ1 / mQ2 : 0.0; }
+    double closest() const { return mClosest; }
     bool within(double rho, double& tIn, double& tOut) const
     {
-        if (!(mQ2 > 1e-24)) return false;
-        const double m2 = mQ0 - mQ1 * mQ1 / mQ2, tc = -mQ1 / mQ2;
-        if (!(rho * rho > m2)) return false;
-        const double half = std::sqrt((rho * rho - m2) / mQ2);
-        tIn = tc - half;
-        tOut = tc + half;
+        if (!(mQ2 > 1e-24) || !(rho * rho > mM2)) return false;
+        const double half = std::sqrt((rho * rho - mM2) / mQ2);
+        tIn = mClosest - half;
+        tOut = mClosest + half;
         return true;
     }
     /// Where g is largest: g rises before it and falls after; +-infinity where g only rises
@@ -140,9 +142,8 @@ public:
         const double s = mAlong / (mCotPhi * root);
         if (s >= 1.0) return kInf;
         if (s <= -1.0) return -kInf;
-        const double tc = -mQ1 / mQ2;
-        const double m = std::sqrt(std::max(0.0, mQ0 - mQ1 * mQ1 / mQ2));
-        return tc + s * m / (std::sqrt(1.0 - s * s) * root);
+        const double m = std::sqrt(std::max(0.0, mM2));
+        return mClosest + s * m / (std::sqrt(1.0 - s * s) * root);
     }
     /// The t in [lo, hi] where g = c, g monotone there and between g(lo) and g(hi) c.
     double level(double c, double lo, double hi) const
@@ -183,6 +184,8 @@ public:
 
 private:
     double mCotPhi, mH0 = 0.0, mAlong = 0.0, mQ0 = 0.0, mQ1 = 0.0, mQ2 = 0.0;
+    double mClosest = 0.0;  ///< t where the line passes the axis closest
+    double mM2 = 0.0;       ///< the square of its distance there
 };
 
 /// Calls visit(band) -> bool (false stops) for every band of cones 0 .. floor(length / dh)
