@@ -501,21 +501,12 @@ double nearestFragment(const ConeRay& ray, const TracedScene& scene, std::uint32
 // misses that cylinder.
 double primitiveEntry(const ConeRay& ray, const TracedScene& scene, std::uint32_t index)
 {
-    const Sphere ball = primitiveBall(scene, index);
+    const PrimitiveCylinder c = primitiveCylinder(scene, index);
+    const Sphere ball = cylinderSphere(c.base, c.end, c.radius_cm);
     const double far = (glm::dot(ball.centre - ray.origin, ray.direction) + ball.radius) /
                        std::max(1e-9, 1.0 - 0.5 * ray.spread);
-    Vec3 a, b;
-    double radius;
-    if (scene.isBranch(index)) {
-        const TracedBranch& br = scene.branches[index];
-        a = br.base_cm, b = br.tip_cm, radius = br.radius_cm;
-    } else {
-        const TracedBough& bough = scene.bough(index);
-        a = bough.base_cm, b = bough.conesEnd_cm;
-        radius = bough.radius_cm + bough.geometry.cone.needleRadius_cm;
-    }
     double tIn, tOut;
-    if (!intersectCylinder(ray, a, b, radius + 0.5 * ray.width(far), tIn, tOut)) {
+    if (!intersectCylinder(ray, c.base, c.end, c.radius_cm + 0.5 * ray.width(far), tIn, tOut)) {
         return -std::numeric_limits<double>::infinity();
     }
     return tIn - 1e-9 * (1.0 + std::abs(tIn));  // below rounding

@@ -152,14 +152,19 @@ struct TracedScene {
     }
 };
 
-/// The ball holding primitive `primitive` (a branch, or a bough's cones' reach R and the
-/// needles' radius about its axis from the base to the cones' end): what the BVH and the
-/// multiscale tracer bound its fragments by (Bvh::nearestFirst).
+/// The cylinder holding primitive `primitive`: a branch, or a bough's cones' reach R and the
+/// needles' radius about its axis from the base to the cones' end.
+struct PrimitiveCylinder {
+    Vec3 base{0.0}, end{0.0};
+    double radius_cm = 0.0;
+};
+PrimitiveCylinder primitiveCylinder(const TracedScene& scene, std::size_t primitive);
+/// The ball about its primitiveCylinder: what the BVH and the multiscale tracer bound its
+/// fragments by (Bvh::nearestFirst).
 Sphere primitiveBall(const TracedScene& scene, std::size_t primitive);
 
-/// Builds scene.bvh over its branches and boughs (in that order of primitive indices), a
-/// bough's box holding its cones' reach R and the needles' radius about the axis from the base
-/// to the cones' end, each with its primitiveBall.
+/// Builds scene.bvh over its branches and boughs (in that order of primitive indices), each
+/// with the box and the ball of its primitiveCylinder.
 void indexPrimitives(TracedScene& scene);
 
 /// Computes every bough's law profiles now (view() and each light's opacityFromLight()), in
