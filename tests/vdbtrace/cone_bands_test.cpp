@@ -115,22 +115,29 @@ std::vector<ConeBand> closedFormBands(const TracedBough& b, const Vec3& o, const
 // or turn part a sliver differently; they are compared as totals only.
 constexpr double kSliver = 0.02;
 
-TEST(ConeBands, TheClosedFormWalksTheBandsAFineMarchFinds)
+// A bough of the paper's needles from `base` to `tip` around a branch of radius `bark`, in a
+// scene of one light that outlives it.
+TracedBough paperBough(const Vec3& base, const Vec3& tip, double bark)
 {
-    scenes::Scene scene = scenes::parseScene(R"({"name": "bands",
+    static const scenes::Scene scene = scenes::parseScene(R"({"name": "bands",
   "camera": {"position": [0, -60, 0], "look_at": [0, 0, 0]},
   "lights": [{"type": "directional", "direction": [0, -1, 1]}],
   "ground": {"type": "none"}, "species": {}, "trees": []})",
-                                             "bands.json");
-    const TracedScene traced = buildTracedScene(scene);
+                                                          "bands.json");
+    static const TracedScene traced = buildTracedScene(scene);
     BoughDescription desc;
-    desc.spec.base_cm = Vec3(0.0);
-    desc.spec.tip_cm = Vec3(10.0, 0.0, 0.0);
-    desc.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};  // the paper's
+    desc.spec.base_cm = base;
+    desc.spec.tip_cm = tip;
+    desc.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
     desc.spec.needles.coneSpacing_cm = 0.9;
-    desc.barkRadius_cm = 0.3;
-    const TracedBough b = makeTracedBough(desc, scene.camera.position_cm, traced.lights,
-                                          *traced.boughLaw, *traced.layers);
+    desc.barkRadius_cm = bark;
+    return makeTracedBough(desc, scene.camera.position_cm, traced.lights, *traced.boughLaw,
+                           *traced.layers);
+}
+
+TEST(ConeBands, TheClosedFormWalksTheBandsAFineMarchFinds)
+{
+    const TracedBough b = paperBough(Vec3(0.0), Vec3(10.0, 0.0, 0.0), 0.3);
     const double R = b.radius_cm, cotPhi = 1.0 / std::tan(kPi / 8);
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -224,19 +231,7 @@ TEST(ConeBands, TheClosedFormWalksTheBandsAFineMarchFinds)
 // finds where it takes a value on either side.
 TEST(ConeBands, GRisesToItsTurnAndFallsAfter)
 {
-    scenes::Scene scene = scenes::parseScene(R"({"name": "turn",
-  "camera": {"position": [0, -60, 0], "look_at": [0, 0, 0]},
-  "lights": [{"type": "directional", "direction": [0, -1, 1]}],
-  "ground": {"type": "none"}, "species": {}, "trees": []})",
-                                             "turn.json");
-    const TracedScene traced = buildTracedScene(scene);
-    BoughDescription desc;
-    desc.spec.base_cm = Vec3(1.0, 2.0, -1.0);
-    desc.spec.tip_cm = Vec3(9.0, 5.0, 3.0);
-    desc.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
-    desc.spec.needles.coneSpacing_cm = 0.9;
-    const TracedBough b = makeTracedBough(desc, scene.camera.position_cm, traced.lights,
-                                          *traced.boughLaw, *traced.layers);
+    const TracedBough b = paperBough(Vec3(1.0, 2.0, -1.0), Vec3(9.0, 5.0, 3.0), 0.0);
     std::mt19937 rng(23);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     int turned = 0;
