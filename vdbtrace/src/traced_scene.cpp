@@ -301,16 +301,11 @@ void indexPrimitives(TracedScene& scene)
         throw std::length_error("more than 2^31 branches and boughs to index");
     }
     const std::size_t count = scene.branches.size() + scene.boughs.size();
-    std::vector<Aabb> boxes;
-    std::vector<Sphere> balls;
-    boxes.reserve(count);
-    balls.reserve(count);
-    for (std::size_t i = 0; i < count; ++i) {
+    scene.bvh = Bvh(count, [&](std::size_t i, Aabb& box, Sphere& ball) {
         const PrimitiveCylinder c = primitiveCylinder(scene, i);
-        boxes.push_back(cylinderBounds(c.base, c.end, c.radius_cm));
-        balls.push_back(cylinderSphere(c.base, c.end, c.radius_cm));
-    }
-    scene.bvh = Bvh(boxes, balls);
+        box = cylinderBounds(c.base, c.end, c.radius_cm);
+        ball = cylinderSphere(c.base, c.end, c.radius_cm);
+    });
 }
 
 TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts& parts)
