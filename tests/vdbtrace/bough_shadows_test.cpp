@@ -106,12 +106,12 @@ TEST(BoughShadows, ABoughsShadowsAreReadBetweenSamplesAlongItsAxis)
     ASSERT_EQ(count, BoughShadows::kMaxSamples);  // 90 cm long, 3.3 cm wide
     double low = 1.0, high = 0.0;
     for (int k = 0; k < count; ++k) {
-        const Vec3 centre = b.base_cm + (k + 0.5) / count * (b.conesEnd_cm - b.base_cm);
+        const Vec3 centre = b.base_cm + (k + 0.5) / count * (b.conesEnd() - b.base_cm);
         const double T = shadows.transmittance(lower, 0, centre, stats);
         low = std::min(low, T);
         high = std::max(high, T);
         if (k + 1 < count) {
-            const Vec3 next = b.base_cm + (k + 1.5) / count * (b.conesEnd_cm - b.base_cm);
+            const Vec3 next = b.base_cm + (k + 1.5) / count * (b.conesEnd() - b.base_cm);
             const double between = shadows.transmittance(lower, 0, 0.5 * (centre + next), stats);
             const double T1 = shadows.transmittance(lower, 0, next, stats);
             EXPECT_NEAR(between, 0.5 * (T + T1), 1e-12) << k;
@@ -124,7 +124,7 @@ TEST(BoughShadows, ABoughsShadowsAreReadBetweenSamplesAlongItsAxis)
     EXPECT_GT(high, 0.5);
     // Past the ends, the end samples.
     const Vec3 before = b.base_cm - 10.0 * b.axis;
-    const Vec3 first = b.base_cm + 0.5 / count * (b.conesEnd_cm - b.base_cm);
+    const Vec3 first = b.base_cm + 0.5 / count * (b.conesEnd() - b.base_cm);
     EXPECT_EQ(shadows.transmittance(lower, 0, before, stats),
               shadows.transmittance(lower, 0, first, stats));
 }

@@ -26,6 +26,8 @@
 namespace pine::vdbtrace {
 namespace {
 
+using test::variantForest;
+
 // The reference as the paper models it: the layer law (these tests check E10, E12, E13).
 bake::BakeSettings paperBake(double voxel_cm)
 {
@@ -130,21 +132,6 @@ TEST(GeometryTracer, NativeCurvesAreTheSameCylinders)
     const double rounding = rmse(curve.image, cylinder.image);
     const double sampling = rmse(otherSamples.image, cylinder.image);
     EXPECT_LT(rounding, 0.05 * sampling) << rounding << " against " << sampling;
-}
-
-// Five firs drawn from two variants of a scatter: each variant's needles are laid out once and
-// instanced by Embree at its trees (native curves only).
-std::string variantForest()
-{
-    nlohmann::json j = nlohmann::json::parse(firScene(R"("diffuse", "shadows")", 96, 72));
-    j["trees"] = nlohmann::json::array({{{"scatter",
-                                          {{"species", "fir"},
-                                           {"count", 5},
-                                           {"region", {{-45, 0}, {45, 70}}},
-                                           {"min_spacing", 25},
-                                           {"variants", 2},
-                                           {"seed", 4}}}}});
-    return j.dump();
 }
 
 TEST(GeometryTracer, AVariantsTreesAreItsFirstTreeMoved)

@@ -77,6 +77,69 @@ TEST(MultiscaleTracer, ImageIsTheSameWhateverTheThreadCount)
     EXPECT_EQ(one.stats.diffuseEvaluations, two.stats.diffuseEvaluations);
 }
 
+TEST(MultiscaleTracer, AVariantsCopiesNeedNoCopyOfItsTree)
+{
+    // The method's parts keep no grown tree: a variant's copies take their boughs and branches
+    // from its first tree, moved, exactly as from a moved copy of it.
+    const scenes::Scene scene = scenes::parseScene(test::variantForest(), "variants.json");
+    const TracedScene copied = buildTracedScene(scene);
+    const TracedScene lean = buildTracedScene(scene, renderMethod("multiscale").parts);
+    ASSERT_EQ(lean.boughs.size(), copied.boughs.size());
+    ASSERT_EQ(lean.branches.size(), copied.branches.size());
+    int moved = 0;
+    for (std::size_t i = 0; i < lean.boughs.size(); ++i) {
+        const TracedBough &a = lean.boughs[i], &b = copied.boughs[i];
+        EXPECT_EQ(a.base_cm, b.base_cm);
+        EXPECT_EQ(a.tip_cm, b.tip_cm);
+        EXPECT_EQ(a.across, b.across);
+        EXPECT_EQ(a.seed, b.seed);
+        EXPECT_EQ(a.barkRadius_cm, b.barkRadius_cm);
+        EXPECT_EQ(a.tree, b.tree);
+        moved += scene.trees[std::size_t(a.tree)].variantOf >= 0;
+    }
+    EXPECT_GT(moved, 0);
+    for (std::size_t i = 0; i < lean.branches.size(); ++i) {
+        EXPECT_EQ(lean.branches[i].base_cm, copied.branches[i].base_cm);
+        EXPECT_EQ(lean.branches[i].tip_cm, copied.branches[i].tip_cm);
+        EXPECT_EQ(lean.branches[i].radius_cm, copied.branches[i].radius_cm);
+    }
+    // A count is an expected value from the boughs' lengths: a moved copy's lengths differ by
+    // rounding.
+    for (std::size_t i = 0; i < scene.trees.size(); ++i) {
+        EXPECT_NEAR(lean.treeCounts[i].needles, copied.treeCounts[i].needles,
+                    1e-12 * copied.treeCounts[i].needles);
+        EXPECT_EQ(lean.treeCounts[i].branches, copied.treeCounts[i].branches);
+    }
+    const RenderResult a = renderMultiscale(lean, {}), b = renderMultiscale(copied, {});
+    EXPECT_EQ(a.image.rgba, b.image.rgba);
+}
+
+TEST(MultiscaleTracer, ALawProfileDroppedIsComputedAgainTheSame)
+{
+    // Law profiles kept within a budget of one byte: each bough's view and profile from the
+    // light is dropped as soon as another is computed, and computed again when asked again.
+    const scenes::Scene scene = scenes::parseScene(
+        firScene(R"("diffuse", "specular", "shadows", "self_shadowing")", 48, 36), "test.json");
+    TracedSceneParts tiny = renderMethod("multiscale").parts;
+    tiny.lawProfileBudget_bytes = 1;
+    const TracedScene kept = buildTracedScene(scene, renderMethod("multiscale").parts);
+    const TracedScene dropped = buildTracedScene(scene, tiny);
+    MultiscaleOptions level3;
+    level3.forceLevel = 3;
+    const RenderResult a = renderMultiscale(kept, level3), b = renderMultiscale(dropped, level3);
+    EXPECT_EQ(a.image.rgba, b.image.rgba);
+    EXPECT_EQ(a.image.aovs, b.image.aovs);
+    EXPECT_EQ(a.stats.shadowRays, b.stats.shadowRays);
+    const LawProfileCounts once = lawProfileCounts(kept), again = lawProfileCounts(dropped);
+    EXPECT_EQ(once.views.dropped, 0u);
+    EXPECT_EQ(once.fromLights.dropped, 0u);
+    EXPECT_GT(once.views.computed, 0u);
+    EXPECT_GT(once.fromLights.computed, 0u);
+    EXPECT_GT(again.views.computed, once.views.computed);
+    EXPECT_GT(again.fromLights.computed, once.fromLights.computed);
+    EXPECT_GT(again.views.dropped + again.fromLights.dropped, 0u);
+}
+
 TEST(MultiscaleTracer, ItsLeanTracedSceneRendersTheSameImage)
 {
     // The method's parts release the grown trees (keeping their counts), and a bough's view
@@ -101,8 +164,10 @@ TEST(MultiscaleTracer, ItsLeanTracedSceneRendersTheSameImage)
     const scenes::Scene every = scenes::parseScene(
         firScene(R"("diffuse", "specular", "shadows", "self_shadowing")", 48, 36), "test.json");
     const TracedScene all = buildTracedScene(every, renderMethod("multiscale").parts);
-    const BoughLighting& kept = all.boughs.front().view().lighting.at(0);
-    const BoughLighting& dropped = lean.boughs.front().view().lighting.at(0);
+    const std::shared_ptr<const BoughView> allView = all.boughs.front().view();
+    const std::shared_ptr<const BoughView> leanView = lean.boughs.front().view();
+    const BoughLighting& kept = allView->lighting.at(0);
+    const BoughLighting& dropped = leanView->lighting.at(0);
     EXPECT_FALSE(kept.diffuse.front.isConstant());
     EXPECT_FALSE(kept.specular.front.isConstant());
     EXPECT_FALSE(kept.transfer.front.isConstant());
@@ -237,17 +302,18 @@ TEST(BoughLaw, EveryBoughLevelQuantityComesFromTheLawOnceAndOnlyWhenNeeded)
     const RenderResult r = renderMultiscale(s.traced, level3);
     EXPECT_EQ(law.calls, 1);  // from two threads, many pixels
     EXPECT_EQ(law.opacityCalls, 0);  // no shadow cone meets the only bough
-    EXPECT_EQ(b.view().alpha.front.mean(), 0.3);
-    EXPECT_EQ(b.view().lighting.at(0).transfer.rear.mean(), 0.05);
-    EXPECT_EQ(b.opacityFromLight(0).mean(), 0.5);
-    EXPECT_EQ(b.opacityFromLight(0).mean(), 0.5);
+    EXPECT_EQ(b.view()->alpha.front.mean(), 0.3);
+    EXPECT_EQ(b.view()->lighting.at(0).transfer.rear.mean(), 0.05);
+    EXPECT_EQ(b.opacityFromLight(0)->mean(), 0.5);
+    EXPECT_EQ(b.opacityFromLight(0)->mean(), 0.5);
     EXPECT_EQ(law.calls, 1);
     EXPECT_EQ(law.opacityCalls, 1);
     const float* centre = r.image.pixel(r.image.width / 2, r.image.height / 2);
     EXPECT_NEAR(centre[3], 1.0 - (1.0 - 0.3) * (1.0 - 0.2), 1e-6);
     // With self-shadowing each half reflects the law's transfer (not its opacity), the rear
     // seen through the front: G = (0.1 I_front + (1 - 0.3) 0.05 I_rear) a_G E_G / pi.
-    const BoughLighting& lit = b.view().lighting.at(0);
+    const std::shared_ptr<const BoughView> view = b.view();
+    const BoughLighting& lit = view->lighting.at(0);
     const double E = s.traced.lights.at(0).power.y, albedo = b.needleAlbedo.y;
     const double expected =
         (0.1 * lit.front.diffuse + 0.7 * 0.05 * lit.rear.diffuse) * albedo / analytic::kPi * E;
@@ -339,7 +405,8 @@ TEST(MultiscaleTracer, BoughLevelCompositesSection66sHalves)
     options.forceLevel = 3;
     const RenderResult r = renderMultiscale(s.traced, options);
     const TracedBough& b = s.traced.boughs.front();
-    const FrontRearProfile& alpha = b.view().alpha;
+    const std::shared_ptr<const BoughView> view = b.view();
+    const FrontRearProfile& alpha = view->alpha;
     const double expected = 1.0 - (1.0 - alpha.front.mean()) * (1.0 - alpha.rear.mean());
     const float centre = r.image.pixel(r.image.width / 2, r.image.height / 2)[3];
     EXPECT_NEAR(centre, expected, 1e-6);

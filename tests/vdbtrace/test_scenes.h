@@ -2,6 +2,8 @@
 // three levels with the thresholds below, lit by a directional and a point light.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 namespace pine::vdbtrace::test {
@@ -27,6 +29,21 @@ inline std::string firScene(const std::string& effects, int width = 96, int heig
   "effects": [)" + effects + R"(],
   "render": {"needle_level_max": 0.8, "cone_level_max": 1.3}
 })";
+}
+
+// Five firs drawn from two variants of a scatter: each variant grown once, its copies moved
+// (the geometry method instances its needles at them; native curves only).
+inline std::string variantForest()
+{
+    nlohmann::json j = nlohmann::json::parse(firScene(R"("diffuse", "shadows")", 96, 72));
+    j["trees"] = nlohmann::json::array({{{"scatter",
+                                          {{"species", "fir"},
+                                           {"count", 5},
+                                           {"region", {{-45, 0}, {45, 70}}},
+                                           {"min_spacing", 25},
+                                           {"variants", 2},
+                                           {"seed", 4}}}}});
+    return j.dump();
 }
 
 }  // namespace pine::vdbtrace::test

@@ -63,7 +63,7 @@ BoughShadows::BoughShadows(const TracedScene& scene, bool selfShadowing)
 
 int BoughShadows::samplesAlong(const TracedBough& b)
 {
-    const double length = glm::length(b.conesEnd_cm - b.base_cm);
+    const double length = glm::length(b.conesEnd() - b.base_cm);
     const double perDiameter = length / std::max(2.0 * b.radius_cm, 1e-9);
     return int(std::clamp(std::ceil(perDiameter), 1.0, double(kMaxSamples)));
 }
@@ -74,14 +74,15 @@ void BoughShadows::fill(std::size_t bough, std::size_t light, RenderStats& stats
     const double R = b.radius_cm;
     const int count = mCount[bough];
     // The opacity of a chord of the bough seen from the camera, at offset xi on its strip.
-    const FrontRearProfile& seen = b.view().alpha;
+    const std::shared_ptr<const BoughView> view = b.view();
+    const FrontRearProfile& seen = view->alpha;
     const auto viewOpacity = [&](double xi) {
         return std::min(0.999, bothHalvesOpacity(seen, b.rearComposite, xi, R, kPointWidth * R));
     };
     double* out = &mValues[mFirst[bough * mScene.lights.size() + light]];
     ShadowSamples section;
     for (int k = 0; k < count; ++k) {
-        const Vec3 x = b.base_cm + (k + 0.5) / count * (b.conesEnd_cm - b.base_cm);
+        const Vec3 x = b.base_cm + (k + 0.5) / count * (b.conesEnd() - b.base_cm);
         Vec3 L, irradiance;
         double distance;
         mScene.lights[light].at(x, L, distance, irradiance);
@@ -114,7 +115,7 @@ void BoughShadows::fill(std::size_t bough, std::size_t light, RenderStats& stats
                                          fractionInFront(o, towardsEye, xi, R));
                 if (mSelfShadowing) {
                     const double alpha = std::min(
-                        0.999, b.opacityFromLight(light).overFootprint(v, R, kPointWidth * R));
+                        0.999, b.opacityFromLight(light)->overFootprint(v, R, kPointWidth * R));
                     weight *= std::pow(1.0 - alpha, fractionInFront(o, towardsLight, v, R));
                 }
                 section.points.push_back({v, weight, u * upShown, u * lift});
@@ -133,7 +134,7 @@ double BoughShadows::transmittance(std::size_t primitive, std::size_t light, con
     const std::size_t key = bough * mScene.lights.size() + light;
     std::call_once(mOnce[key], [&] { fill(bough, light, stats); });
     const TracedBough& b = mScene.boughs[bough];
-    const Vec3 span = b.conesEnd_cm - b.base_cm;
+    const Vec3 span = b.conesEnd() - b.base_cm;
     const int count = mCount[bough];
     // Where x lies between the samples, which stand at the centres of `count` equal parts.
     const double u = glm::dot(x - b.base_cm, span) / glm::dot(span, span) * count - 0.5;

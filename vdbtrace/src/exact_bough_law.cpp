@@ -67,7 +67,7 @@ bool chord(const TracedBough& b, const Vec3& d, const Vec3& across, int k, int p
     const double c = glm::dot(d, b.axis), s = std::sqrt(std::max(0.0, 1.0 - c * c));
     const double cotangent = s > 0.05 ? std::abs(c) / s : 20.0;
     const double reach = std::sqrt(std::max(0.0, b.radius_cm * b.radius_cm - xi * xi)) * cotangent;
-    const double cones = glm::length(b.conesEnd_cm - b.base_cm);
+    const double cones = glm::length(b.conesEnd() - b.base_cm);
     const double apexes = glm::length(b.tip_cm - b.base_cm);
     const double dh = b.geometry.coneSpacing_cm;
     const double shift = std::fmod(0.5 + 0.6180339887498949 * k, 1.0);

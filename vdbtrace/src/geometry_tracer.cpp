@@ -601,7 +601,7 @@ void layOut(const TracedScene& scene, const std::vector<long long>& variant,
         const TracedBough& b = scene.boughs[k];
         const NeedleLayout layout(b);
         if (!(layout.length() > 0.0 && layout.radius() > 0.0)) continue;
-        box.grow(cylinderBounds(b.base_cm, b.conesEnd_cm, b.radius_cm));
+        box.grow(cylinderBounds(b.base_cm, b.conesEnd(), b.radius_cm));
         const long long v = b.tree >= 0 ? variant[std::size_t(b.tree)] : -1;
         if (v >= 0 && scene.scene->trees[std::size_t(b.tree)].variantOf >= 0) continue;
         CylinderSet& set = v >= 0 ? instancing.variants[std::size_t(v)].needles : needles;

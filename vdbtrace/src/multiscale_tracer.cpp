@@ -302,7 +302,7 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
         // take the law's coverage.
         if (coverage < 1.0 && covered > 0.0 && b.rearComposite == RearComposite::Share) {
             const double target =
-                bothHalvesOpacity(b.view().alpha, b.rearComposite, xi, b.radius_cm, w);
+                bothHalvesOpacity(b.view()->alpha, b.rearComposite, xi, b.radius_cm, w);
             const double k = std::min(target, 0.999) / covered;
             double was = 0.0, before = 0.0;  // covered in front, as composited and as scaled
             for (NeedleHit& h : mNeedleHits) {
@@ -357,7 +357,7 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     const TracedBough& b = mScene.bough(index);
     // Where the cone passes the needles: they reach from the base to the cones' end.
     Passage p;
-    if (!closestPassage(ray, b.base_cm, b.conesEnd_cm, p)) return;
+    if (!closestPassage(ray, b.base_cm, b.conesEnd(), p)) return;
     const double w = ray.width(p.t);
     if (mForceLevel) return addBoughAt(ray, index, Level(mForceLevel), p);
     const LevelBlend blend = blendLevels(w, b.geometry.coneSpacing_cm, mSettings);
@@ -411,8 +411,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     }
     // The volume spans base to the law's strip end: the tip (the cones' region sheared into a
     // cylinder of equal volume) or the cones' end (the exact law, whose chords cover them).
-    if (!closestPassage(ray, b.base_cm, b.stripEnd_cm, p)) return;
-    if (!intersectCylinder(ray, b.base_cm, b.stripEnd_cm, b.radius_cm, tIn, tOut)) {
+    if (!closestPassage(ray, b.base_cm, b.stripEnd(), p)) return;
+    if (!intersectCylinder(ray, b.base_cm, b.stripEnd(), b.radius_cm, tIn, tOut)) {
         tIn = tOut = p.t;
     }
 
@@ -421,7 +421,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     // over the footprint at the chord's signed offset from the axis.
     ++mStats.boughHits;
     const double R = b.radius_cm;
-    const BoughView& view = b.view();
+    const std::shared_ptr<const BoughView> kept = b.view();
+    const BoughView& view = *kept;
     const double frontAlpha = view.alpha.front.overFootprint(xi, R, w);
     // What the rear's share is divided by to composite behind the front (bough_law.h).
     const double behindFront =

@@ -36,7 +36,7 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         const bool branch = scene.isBranch(index);
         if (!branch && !throughBoughs) return true;
         const Vec3 a = branch ? scene.branches[index].base_cm : scene.bough(index).base_cm;
-        const Vec3 b = branch ? scene.branches[index].tip_cm : scene.bough(index).stripEnd_cm;
+        const Vec3 b = branch ? scene.branches[index].tip_cm : scene.bough(index).stripEnd();
         Passage p;
         if (!closestPassage(ray, a, b, p) || !(p.t < tMax + behind)) return true;
         // The points' lines pass the occluder shifted along its strip by their offsets (scaled
@@ -50,15 +50,16 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         // The footprint's width across the occluder's strip (ShadowSamples::footprintNormal).
         const double tilt = glm::dot(n, at.footprintNormal);
         const double w = pointWidth * ray.width(p.t) * std::sqrt(std::max(0.0, 1.0 - tilt * tilt));
+        std::shared_ptr<const StripProfile> fromLight;  // the bough's, once a point reads it
         bool dark = true;  // every point: nothing further shows
         for (std::size_t k = 0; k < T.size(); ++k) {
             const ShadowSamples::Point& q = at.points[k];
             if (p.t < tMax - q.towardsLight_cm) {  // else the occluder lies beyond this point
                 const double g = gap + along * q.offset_cm + aside * q.sideways_cm;
+                if (!branch && !fromLight) fromLight = scene.bough(index).opacityFromLight(light);
                 const double alpha =
                     branch ? stripCoverage(g, scene.branches[index].radius_cm, w)
-                           : scene.bough(index).opacityFromLight(light).overFootprint(
-                                 g, scene.bough(index).radius_cm, w);
+                           : fromLight->overFootprint(g, scene.bough(index).radius_cm, w);
                 T[k] *= 1.0 - alpha;
             }
             dark = dark && T[k] < 1e-4;

@@ -14,8 +14,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <deque>
 #include <limits>
+#include <memory>
 #include <mutex>
+#include <shared_mutex>
 #include <stdexcept>
 #include <utility>
 
@@ -84,37 +88,168 @@ Vec3 stripAcross(const Vec3& axis, const Vec3& towards)
     return n > 1e-9 ? c / n : analytic::anyPerpendicular(axis);
 }
 
+// The law profiles a scene's boughs keep (TracedBough::view and opacityFromLight), oldest
+// first, within a budget: a landscape's 1.3 million views and 1.6 million profiles seen from
+// the light would keep 1.3 GB, though each is read by the few neighbouring pixels (and their
+// shadow cones) that meet its bough, which are rendered together. A bough points to its
+// profiles weakly; the cache holds them, and whoever reads them.
+class LawProfileCache {
+public:
+    explicit LawProfileCache(std::size_t budget_bytes) : mBudget(budget_bytes) {}
+    enum Kind { kView, kFromLight };
+    // A profile of `bytes` just computed: kept, and the oldest dropped while over the budget.
+    void keep(std::shared_ptr<const void> profile, std::size_t bytes, Kind kind)
+    {
+        ++mCounts[kind].computed;
+        const std::lock_guard<std::mutex> lock(mMutex);
+        mKept.push_back({std::move(profile), bytes, kind});
+        mBytes += bytes;
+        while (mBytes > mBudget && mKept.size() > 1) {
+            mBytes -= mKept.front().bytes;
+            ++mCounts[mKept.front().kind].dropped;
+            mKept.pop_front();
+        }
+    }
+    // Nothing is ever dropped: a profile once kept can be read without a lock.
+    bool keepsAll() const { return mBudget == std::numeric_limits<std::size_t>::max(); }
+    ProfileCounts counts(Kind kind) const
+    {
+        return {mCounts[kind].computed.load(), mCounts[kind].dropped.load()};
+    }
+    // Held shared while a bough's profile is read, alone while it is computed: one asked by
+    // two threads at once is computed once.
+    std::shared_mutex& guarding(const void* slot)
+    {
+        return mGuards[(reinterpret_cast<std::uintptr_t>(slot) / 64) % kGuards].mutex;
+    }
+
+private:
+    struct Kept {
+        std::shared_ptr<const void> profile;
+        std::size_t bytes;
+        Kind kind;
+    };
+    struct Counts {
+        std::atomic<std::uint64_t> computed{0}, dropped{0};
+    };
+    std::mutex mMutex;
+    std::deque<Kept> mKept;  ///< oldest first
+    std::size_t mBytes = 0;
+    const std::size_t mBudget;
+    Counts mCounts[2];
+    struct alignas(64) Guard {  // one a cache line: threads reading apart do not share one
+        std::shared_mutex mutex;
+    };
+    static constexpr std::size_t kGuards = 256;
+    Guard mGuards[kGuards];
+};
+
 // What every bough of a scene evaluates its law with: one, shared, for all of them.
 struct BoughLawContext {
+    explicit BoughLawContext(std::size_t profileBudget_bytes) : profiles(profileBudget_bytes) {}
     const BoughLaw* law = nullptr;
     const LayerModel* layers = nullptr;
     BoughLawNeeds needs;
     Vec3 eye_cm{0.0};
     std::vector<Light> lights;
+    mutable LawProfileCache profiles;
 };
 
-// A bough's own: its profiles once computed. The directions they are computed for are derived
-// again from the bough and the context, not kept: a landscape has 3.3 million boughs, of which
-// only those a cone meets at level 3 ever compute a view.
+// A bough's own: where its profiles are, while kept. The directions they are computed for
+// are derived again from the bough and the context, not kept: a landscape has 3.3 million
+// boughs, of which only those a cone or a shadow cone meets ever compute one.
 struct BoughLawEvaluation {
-    std::shared_ptr<const BoughLawContext> context;
-    std::once_flag viewOnce;
-    std::unique_ptr<const BoughView> view;
-    struct FromLight {
-        std::once_flag once;
-        StripProfile profile;
+    explicit BoughLawEvaluation(std::size_t lights)
+        : moreLights(lights > 1 ? std::make_unique<Slot<StripProfile>[]>(lights - 1) : nullptr)
+    {
+    }
+    // Where a profile is while the cache keeps it: read and set under
+    // LawProfileCache::guarding(this); where the cache keeps all, also published once made.
+    template <class T>
+    struct Slot {
+        std::weak_ptr<const T> weak;
+        std::atomic<const T*> published{nullptr};
     };
-    std::unique_ptr<FromLight[]> fromLight;  ///< one per light
+    Slot<BoughView> view;
+    Slot<StripProfile> firstLight;                 ///< from light 0
+    std::unique_ptr<Slot<StripProfile>[]> moreLights;  ///< from lights 1, 2, ...
+    Slot<StripProfile>& fromLight(std::size_t light)
+    {
+        return light ? moreLights[light - 1] : firstLight;
+    }
 };
+
+// `slot`'s profile, or `compute()`'s kept in the cache as `kind`, `bytes(profile)` large.
+template <class T, class Compute, class Bytes>
+std::shared_ptr<const T> kept(BoughLawEvaluation::Slot<T>& slot, LawProfileCache& cache,
+                              LawProfileCache::Kind kind, Compute&& compute, Bytes&& bytes)
+{
+    // Where the cache keeps all, it owns the profile as long as the scene: the pointer
+    // returned owns nothing, and the read costs no lock (a forest's shadow cones read their
+    // occluders' profiles millions of times).
+    if (const T* published = slot.published.load(std::memory_order_acquire)) {
+        return std::shared_ptr<const T>(std::shared_ptr<const T>(), published);
+    }
+    std::shared_mutex& guard = cache.guarding(&slot);
+    {
+        const std::shared_lock<std::shared_mutex> reading(guard);
+        if (std::shared_ptr<const T> held = slot.weak.lock()) return held;
+    }
+    const std::lock_guard<std::shared_mutex> computing(guard);
+    if (std::shared_ptr<const T> held = slot.weak.lock()) return held;
+    // Only whole: a throw keeps nothing, to try again.
+    auto made = std::make_shared<const T>(compute());
+    slot.weak = made;
+    cache.keep(made, bytes(*made), kind);
+    if (cache.keepsAll()) slot.published.store(made.get(), std::memory_order_release);
+    return made;
+}
+
+BoughLawSlot::BoughLawSlot(std::shared_ptr<const BoughLawContext> context)
+    : mContext(std::move(context))
+{
+}
+
+BoughLawSlot::BoughLawSlot(BoughLawSlot&& other) noexcept
+    : mContext(std::move(other.mContext)), mEvaluation(other.mEvaluation.exchange(nullptr))
+{
+}
+
+BoughLawSlot& BoughLawSlot::operator=(BoughLawSlot other) noexcept
+{
+    std::swap(mContext, other.mContext);
+    BoughLawEvaluation* mine = mEvaluation.exchange(other.mEvaluation.load());
+    other.mEvaluation.store(mine);
+    return *this;
+}
+
+BoughLawSlot::~BoughLawSlot() { delete mEvaluation.load(); }
+
+const BoughLawContext& BoughLawSlot::context() const
+{
+    if (!mContext) throw std::logic_error("a bough made without makeTracedBough has no law");
+    return *mContext;
+}
+
+BoughLawEvaluation& BoughLawSlot::evaluation() const
+{
+    BoughLawEvaluation* e = mEvaluation.load(std::memory_order_acquire);
+    if (e) return *e;
+    auto made = std::make_unique<BoughLawEvaluation>(context().lights.size());
+    if (mEvaluation.compare_exchange_strong(e, made.get(), std::memory_order_acq_rel)) {
+        return *made.release();
+    }
+    return *e;  // another thread's, made meanwhile
+}
+
+LawProfileCounts lawProfileCounts(const TracedScene& scene)
+{
+    if (!scene.lawContext) return {};
+    const LawProfileCache& cache = scene.lawContext->profiles;
+    return {cache.counts(LawProfileCache::kView), cache.counts(LawProfileCache::kFromLight)};
+}
 
 namespace {
-
-// A bough not made by makeTracedBough has no law to ask.
-BoughLawEvaluation& evaluation(const std::shared_ptr<BoughLawEvaluation>& law)
-{
-    if (!law) throw std::logic_error("a bough made without makeTracedBough has no law");
-    return *law;
-}
 
 // A bough's law sees the camera (V) and each light (L) from its centre.
 Vec3 boughCentre(const TracedBough& b) { return 0.5 * (b.base_cm + b.tip_cm); }
@@ -127,57 +262,78 @@ Vec3 towardsLight(const Light& light, const Vec3& centre)
     return L;
 }
 
-}  // namespace
+// A kept profile's shared pointer's count and its entry in the cache.
+constexpr std::size_t kKeptOverhead_bytes = 64;
 
-const BoughView& TracedBough::view() const
+std::size_t heapBytes(const FrontRearProfile& p)
 {
-    BoughLawEvaluation& e = evaluation(law);
-    std::call_once(e.viewOnce, [&] {
-        const BoughLawContext& c = *e.context;
-        const Vec3 centre = boughCentre(*this);
-        const Vec3 V = glm::normalize(c.eye_cm - centre);
-        std::vector<Vec3> towards;
-        for (const Light& light : c.lights) towards.push_back(towardsLight(light, centre));
-        BoughShading shading = c.law->shade(*this, V, towards, *c.layers, c.needs);
-        if (shading.lights.size() != towards.size()) {
-            throw std::logic_error("a bough law shaded another number of lights");
-        }
-        auto view = std::make_unique<BoughView>();
-        view->alpha = std::move(shading.alpha);
-        const analytic::ConeGeometry& cone = geometry.cone;
-        for (std::size_t i = 0; i < towards.size(); ++i) {
-            BoughLighting lit;
-            // A law that shades the needles does not read the faces' mean I^cyl.
-            if (!shadesNeedles) {
-                const auto sums = analytic::coneSums(
-                    cone,
-                    analytic::coneIntegrals(cone.aperture_rad, axis, towards[i], V, exponent),
-                    exponent);
-                lit.front = analytic::meanReflectance(sums.front);
-                lit.rear = analytic::meanReflectance(sums.rear);
-            }
-            // What the render's effects do not read is not kept (half a landscape's views).
-            BoughLightTransfer& shaded = shading.lights[i];
-            if (c.needs.transfer) lit.transfer = std::move(shaded.transfer);
-            if (c.needs.diffuse) lit.diffuse = std::move(shaded.diffuse);
-            if (c.needs.specular) lit.specular = std::move(shaded.specular);
-            view->lighting.push_back(lit);
-        }
-        e.view = std::move(view);  // only whole: a throw leaves the flag unset to try again
-    });
-    return *e.view;
+    return p.front.heapBytes() + p.rear.heapBytes();
 }
 
-const StripProfile& TracedBough::opacityFromLight(std::size_t light) const
+// What a view holds, for the cache's budget.
+std::size_t viewBytes(const BoughView& view)
 {
-    BoughLawEvaluation& e = evaluation(law);
-    BoughLawEvaluation::FromLight& slot = e.fromLight[light];
-    std::call_once(slot.once, [&] {
-        const BoughLawContext& c = *e.context;
-        slot.profile = c.law->opacityFromLight(
-            *this, towardsLight(c.lights[light], boughCentre(*this)), *c.layers);
-    });
-    return slot.profile;
+    std::size_t bytes = kKeptOverhead_bytes + sizeof(BoughView) + heapBytes(view.alpha) +
+                        view.lighting.capacity() * sizeof(BoughLighting);
+    for (const BoughLighting& lit : view.lighting) {
+        bytes += heapBytes(lit.transfer) + heapBytes(lit.diffuse) + heapBytes(lit.specular);
+    }
+    return bytes;
+}
+
+BoughView computeView(const TracedBough& b, const BoughLawContext& c)
+{
+    const Vec3 centre = boughCentre(b);
+    const Vec3 V = glm::normalize(c.eye_cm - centre);
+    std::vector<Vec3> towards;
+    for (const Light& light : c.lights) towards.push_back(towardsLight(light, centre));
+    BoughShading shading = c.law->shade(b, V, towards, *c.layers, c.needs);
+    if (shading.lights.size() != towards.size()) {
+        throw std::logic_error("a bough law shaded another number of lights");
+    }
+    BoughView view;
+    view.alpha = std::move(shading.alpha);
+    const analytic::ConeGeometry& cone = b.geometry.cone;
+    view.lighting.reserve(towards.size());
+    for (std::size_t i = 0; i < towards.size(); ++i) {
+        BoughLighting lit;
+        // A law that shades the needles does not read the faces' mean I^cyl.
+        if (!b.shadesNeedles) {
+            const auto sums = analytic::coneSums(
+                cone, analytic::coneIntegrals(cone.aperture_rad, b.axis, towards[i], V, b.exponent),
+                b.exponent);
+            lit.front = analytic::meanReflectance(sums.front);
+            lit.rear = analytic::meanReflectance(sums.rear);
+        }
+        // What the render's effects do not read is not kept (half a landscape's views).
+        BoughLightTransfer& shaded = shading.lights[i];
+        if (c.needs.transfer) lit.transfer = std::move(shaded.transfer);
+        if (c.needs.diffuse) lit.diffuse = std::move(shaded.diffuse);
+        if (c.needs.specular) lit.specular = std::move(shaded.specular);
+        view.lighting.push_back(lit);
+    }
+    return view;
+}
+
+}  // namespace
+
+std::shared_ptr<const BoughView> TracedBough::view() const
+{
+    const BoughLawContext& c = law.context();
+    return kept(law.evaluation().view, c.profiles, LawProfileCache::kView,
+                [&] { return computeView(*this, c); }, viewBytes);
+}
+
+std::shared_ptr<const StripProfile> TracedBough::opacityFromLight(std::size_t light) const
+{
+    const BoughLawContext& c = law.context();
+    return kept(
+        law.evaluation().fromLight(light), c.profiles, LawProfileCache::kFromLight,
+        [&] {
+            return c.law->opacityFromLight(
+                *this, towardsLight(c.lights[light], boughCentre(*this)), *c.layers);
+        },
+        [](const StripProfile& p) { return kKeptOverhead_bytes + sizeof(p) + p.heapBytes(); });
 }
 
 namespace {
@@ -198,7 +354,7 @@ TracedBough makeTracedBough(const BoughDescription& d,
     b.radius_cm = analytic::boughRadius(cone);
     b.layerOpacity = analytic::layerOpacity(cone);
     b.barkRadius_cm = std::clamp(d.barkRadius_cm, 0.0, b.radius_cm);
-    b.conesEnd_cm = b.tip_cm + cone.needleLength_cm * std::cos(cone.aperture_rad) * b.axis;
+    b.conesReach_cm = cone.needleLength_cm * std::cos(cone.aperture_rad);
     b.needleAlbedo = d.spec.needleAlbedo;
     b.specularWeight = d.specularWeight;
     b.tree = d.tree;
@@ -206,25 +362,21 @@ TracedBough makeTracedBough(const BoughDescription& d,
     b.seed = d.seed;
     const BoughLawTraits traits = law.traits();
     b.rearComposite = traits.rear;
-    b.stripEnd_cm = traits.stripToConesEnd ? b.conesEnd_cm : b.tip_cm;
+    b.stripToConesEnd = traits.stripToConesEnd;
     b.shadesNeedles = traits.shadesNeedles;
 
     b.across = stripAcross(b.axis, glm::normalize(context->eye_cm - boughCentre(b)));
-    if (evaluated) {
-        auto e = std::make_shared<BoughLawEvaluation>();
-        e->context = context;
-        e->fromLight = std::make_unique<BoughLawEvaluation::FromLight[]>(context->lights.size());
-        b.law = std::move(e);
-    }
+    if (evaluated) b.law = BoughLawSlot(context);
     return b;
 }
 
 std::shared_ptr<const BoughLawContext> lawContext(const Vec3& eye_cm,
                                                   const std::vector<Light>& lights,
                                                   const BoughLaw& law, const LayerModel& layers,
-                                                  const BoughLawNeeds& needs)
+                                                  const BoughLawNeeds& needs,
+                                                  std::size_t viewBudget_bytes)
 {
-    auto c = std::make_shared<BoughLawContext>();
+    auto c = std::make_shared<BoughLawContext>(viewBudget_bytes);
     c->law = &law;
     c->layers = &layers;
     c->needs = needs;
@@ -239,7 +391,9 @@ TracedBough makeTracedBough(const BoughDescription& d, const Vec3& eye_cm,
                             const std::vector<Light>& lights, const BoughLaw& law,
                             const LayerModel& layers, const BoughLawNeeds& needs)
 {
-    return makeTracedBough(d, lawContext(eye_cm, lights, law, layers, needs), true);
+    return makeTracedBough(
+        d, lawContext(eye_cm, lights, law, layers, needs, std::numeric_limits<std::size_t>::max()),
+        true);
 }
 
 void computeLawProfiles(const TracedScene& scene)
@@ -285,7 +439,7 @@ PrimitiveCylinder primitiveCylinder(const TracedScene& scene, std::size_t primit
         return {b.base_cm, b.tip_cm, b.radius_cm};
     }
     const TracedBough& b = scene.bough(primitive);
-    return {b.base_cm, b.conesEnd_cm, b.radius_cm + b.geometry.cone.needleRadius_cm};
+    return {b.base_cm, b.conesEnd(), b.radius_cm + b.geometry.cone.needleRadius_cm};
 }
 
 Sphere primitiveBall(const TracedScene& scene, std::size_t primitive)
@@ -336,36 +490,55 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     out.shadowOrigin = origin;
     out.lights = unifiedLights(scene);
     out.trees.resize(scene.trees.size());
-    // A scatter's variant is grown once, at its first tree, and moved to the others' bases.
+    // A scatter's variant is grown once, at its first tree. A copy's boughs and branches are
+    // its first tree's moved to its base (scenes::movedBy's sums, so the same numbers); the
+    // copy itself is made only where the grown trees are kept: a landscape's are about
+    // 500 MB, all alive at once until its boughs are made.
+    const auto firstOf = [&](std::size_t i) {
+        const long long p = scene.trees[i].variantOf;
+        return p < 0 ? i : std::size_t(p);
+    };
+    const auto offsetOf = [&](std::size_t i) {
+        return scene.trees[i].base_cm - scene.trees[firstOf(i)].base_cm;
+    };
     tbb::parallel_for(std::size_t(0), scene.trees.size(), [&](std::size_t i) {
         const scenes::TreePlacement& placement = scene.trees[i];
         if (placement.variantOf >= 0) return;
         out.trees[i] = scenes::growTree(scene.species.at(placement.species), placement);
     });
-    tbb::parallel_for(std::size_t(0), scene.trees.size(), [&](std::size_t i) {
-        const long long p = scene.trees[i].variantOf;
-        if (p < 0) return;
-        out.trees[i] = scenes::movedBy(out.trees[std::size_t(p)],
-                                       scene.trees[i].base_cm - scene.trees[std::size_t(p)].base_cm);
-    });
+    if (parts.grownTrees) {
+        tbb::parallel_for(std::size_t(0), scene.trees.size(), [&](std::size_t i) {
+            const std::size_t first = firstOf(i);
+            if (first != i) out.trees[i] = scenes::movedBy(out.trees[first], offsetOf(i));
+        });
+    }
+    // The grown tree that tree i's boughs and branches are made from: its own, or its first
+    // tree's, moved by offsetOf(i).
+    const auto grown = [&](std::size_t i) -> const scenes::Tree& {
+        return out.trees[parts.grownTrees ? i : firstOf(i)];
+    };
 
     // Each tree's boughs described in parallel, then made in place, tree by tree, in the
     // trees' order (the primitive indices do not depend on the threads).
     std::vector<std::vector<BoughDescription>> described(out.trees.size());
     tbb::parallel_for(std::size_t(0), out.trees.size(), [&](std::size_t i) {
-        const scenes::Tree& tree = out.trees[i];
+        const scenes::Tree& tree = grown(i);
+        const bool moved = &tree != &out.trees[i];
+        const Vec3 offset = moved ? offsetOf(i) : Vec3(0.0);
         const scenes::Species& species = *tree.species;
         const std::vector<bake::BoughSpec> specs = bake::treeBoughs(tree);
         for (std::size_t j = 0; j < specs.size(); ++j) {
             if (!(glm::length(specs[j].tip_cm - specs[j].base_cm) > 0.0)) continue;
             BoughDescription d;
             d.spec = specs[j];
+            if (moved) {
+                d.spec.base_cm += offset;
+                d.spec.tip_cm += offset;
+            }
             d.specularWeight = species.needleSpecular;
             d.exponent = species.specularExponent;
             // A variant's copies bear its first tree's needles (geometry instances them).
-            const long long variantOf = scene.trees[i].variantOf;
-            const std::size_t first = variantOf < 0 ? i : std::size_t(variantOf);
-            d.seed = unsigned(first * 7919u + j * 104729u + scene.trees[i].seed);
+            d.seed = unsigned(firstOf(i) * 7919u + j * 104729u + scene.trees[i].seed);
             d.tree = int(i);
             if (solidBark) d.barkRadius_cm = tree.segments[tree.boughs[j].segment].radius_cm;
             described[i].push_back(d);
@@ -375,17 +548,23 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     std::vector<std::size_t> firstBranch(out.trees.size() + 1, 0);
     for (std::size_t i = 0; i < out.trees.size(); ++i) {
         firstBough[i + 1] = firstBough[i] + described[i].size();
-        firstBranch[i + 1] = firstBranch[i] + out.trees[i].segments.size();
+        firstBranch[i + 1] = firstBranch[i] + grown(i).segments.size();
     }
     out.branches.resize(firstBranch.back());
     out.boughs.resize(firstBough.back());
-    const auto context = lawContext(scene.camera.position_cm, out.lights, *law, layers, needs);
+    const auto context = lawContext(scene.camera.position_cm, out.lights, *law, layers, needs,
+                                    parts.lawProfileBudget_bytes);
+    if (parts.boughLaws) out.lawContext = context;
     tbb::parallel_for(std::size_t(0), out.trees.size(), [&](std::size_t i) {
-        const scenes::Tree& tree = out.trees[i];
+        const scenes::Tree& tree = grown(i);
+        const bool moved = &tree != &out.trees[i];
+        const Vec3 offset = moved ? offsetOf(i) : Vec3(0.0);
+        const auto placed = [&](const Vec3& p) { return moved ? p + offset : p; };
         const Vec3 bark = scenes::barkColour(*tree.species);
         for (std::size_t k = 0; k < tree.segments.size(); ++k) {
             const scenes::Segment& s = tree.segments[k];
-            out.branches[firstBranch[i] + k] = {s.base_cm, s.tip_cm, s.radius_cm, bark, int(i)};
+            out.branches[firstBranch[i] + k] = {placed(s.base_cm), placed(s.tip_cm), s.radius_cm,
+                                                bark, int(i)};
         }
         for (std::size_t k = 0; k < described[i].size(); ++k) {
             TracedBough& b = out.boughs[firstBough[i] + k];
@@ -395,7 +574,9 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     });
 
     out.treeCounts.reserve(out.trees.size());
-    for (const scenes::Tree& tree : out.trees) out.treeCounts.push_back(tree.counts());
+    for (std::size_t i = 0; i < out.trees.size(); ++i) {
+        out.treeCounts.push_back(grown(i).counts());
+    }
     if (!parts.grownTrees) std::vector<scenes::Tree>().swap(out.trees);
     if (parts.primitiveIndex) indexPrimitives(out);
     return out;

@@ -212,9 +212,12 @@ struct FrameOverrides {
 int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs,
            vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles,
-           const ModelOverrides& model, const FrameOverrides& frame, double maxMemoryGiB)
+           const ModelOverrides& model, const FrameOverrides& frame, double maxMemoryGiB,
+           double lawCacheMiB)
 {
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
+    vdbtrace::TracedSceneParts parts = method.parts;
+    if (lawCacheMiB > 0.0) parts.lawProfileBudget_bytes = std::size_t(lawCacheMiB * (1 << 20));
     // The extension decides the format: only EXR holds the render (its PNG goes beside it).
     std::string extension = out.extension().string();
     for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -279,7 +282,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                 scene.camera.height = frame.height;
             }
         },
-        vdbtrace::renderMethod(methodName).parts);
+        parts);
     std::map<int, fs::path> treesRead;  // a tree given twice would be drawn twice
     for (std::size_t i = 0; i < bakedFrom.size(); ++i) {
         checkBakedFrom(gridFiles[i], bakedFrom[i], *loaded, sceneFile);
@@ -322,6 +325,10 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     options.window = frame.crop;
     const vdbtrace::RenderResult result = method.render(loaded->traced, settings, options);
     rendering.finish();
+    const vdbtrace::LawProfileCounts profiles = vdbtrace::lawProfileCounts(loaded->traced);
+    // What is written is the image alone: the traced scene (most of a landscape's memory) goes
+    // before the files are made.
+    loaded->traced = vdbtrace::TracedScene();
 
     const auto& s = loaded->scene;
     const nlohmann::json effects = vdbtrace::toJson(vdbtrace::EffectsPlan::from(s.effects));
@@ -375,6 +382,13 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                 j["crop"] = {frame.crop.x0, frame.crop.y0, frame.crop.x1, frame.crop.y1};
             }
             j["threads"] = tbb::this_task_arena::max_concurrency();
+            const auto counted = [](const vdbtrace::ProfileCounts& c) {
+                return nlohmann::json{{"computed", c.computed}, {"dropped", c.dropped}};
+            };
+            if (profiles.views.computed + profiles.fromLights.computed > 0) {
+                j["law_profiles"] = {{"views", counted(profiles.views)},
+                                     {"from_lights", counted(profiles.fromLights)}};
+            }
             j.update(methodSettings);
             vdbtrace::writeJsonAtomically(j, statsFile);
         }
@@ -774,7 +788,7 @@ constexpr std::pair<const char*, const char*> kMethodOptions[] = {
     {"--voxel-size", "reference"},  {"--grids", "reference"},
     {"--subpixels", "reference"},   {"--samples", "geometry"},
     {"--sample-seed", "geometry"},  {"--needle-primitive", "geometry"},
-    {"--force-level", "multiscale"}};
+    {"--force-level", "multiscale"}, {"--law-cache", "multiscale"}};
 
 /// --max-memory (GiB) on `cmd`, for `task` ("a render").
 void addMaxMemory(CLI::App& cmd, double& gib, const std::string& task)
@@ -877,6 +891,12 @@ int main(int argc, char** argv)
     renderCmd->add_option("--force-level", settings.multiscale.forceLevel,
                           "multiscale: shade every bough hit at level 1, 2 or 3")
         ->check(CLI::Range(0, 3));
+    double lawCacheMiB = 0.0;  // 0: keep every profile
+    renderCmd->add_option("--law-cache", lawCacheMiB,
+                          "multiscale: MiB the boughs' law profiles (views, shadows) may keep "
+                          "(default: all); the oldest are dropped and computed again, the same, "
+                          "if asked again (a landscape: 1.3 GB kept, 64 MiB enough)")
+        ->check(CLI::Range(1.0, 1e7));
 
     bool scaling = false;
     auto* benchCmd = app.add_subcommand(
@@ -986,7 +1006,7 @@ int main(int argc, char** argv)
             }
             if (!crop.empty()) parseCrop(crop, frame.crop);
             return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles, model,
-                          frame, maxMemoryGiB);
+                          frame, maxMemoryGiB, lawCacheMiB);
         }
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
         if (*compareCmd) {

@@ -37,7 +37,7 @@ inline double coneHeight(const TracedBough& b, double cotPhi, const Vec3& x, dou
 inline bool layeredInterval(const TracedBough& b, const Vec3& o, const Vec3& d, double& tIn,
                             double& tOut)
 {
-    return intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.conesEnd_cm, b.radius_cm, tIn, tOut);
+    return intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.conesEnd(), b.radius_cm, tIn, tOut);
 }
 
 /// Whether x lies inside the bark of bough b's branch: within barkRadius_cm of the axis,

@@ -6,6 +6,7 @@
 
 #include "pine/vdbtrace/geometry.h"
 
+#include <cstddef>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -23,6 +24,8 @@ public:
     bool isConstant() const { return mPrefix.empty(); }
     /// A sampled profile's cells, as given to sampled(); none for a constant.
     std::vector<double> cellValues() const;
+    /// What it holds beyond itself, in bytes.
+    std::size_t heapBytes() const { return mPrefix.capacity() * sizeof(double); }
     /// The mean over the strip.
     double mean() const;
     /// (1 / w) times the integral of the value over the footprint [gap - w/2, gap + w/2]

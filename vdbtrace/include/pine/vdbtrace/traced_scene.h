@@ -13,7 +13,10 @@
 #include "pine/vdbtrace/bvh.h"
 #include "pine/vdbtrace/strip_profile.h"
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -59,8 +62,32 @@ struct BoughView {
     std::vector<BoughLighting> lighting;  ///< one per light
 };
 
-/// What a bough's law profiles are computed from, and them once computed (traced_scene.cpp).
+/// What every bough of a scene evaluates its law with, and the views its boughs keep
+/// (traced_scene.cpp).
+struct BoughLawContext;
+/// A bough's law profiles once computed (traced_scene.cpp).
 struct BoughLawEvaluation;
+
+/// A bough's hold on its law: the context it shares with the scene's other boughs, and its
+/// own evaluation, made on first use (most of a landscape's 3.3 million boughs are never
+/// asked). A copy shares the context and starts with nothing computed.
+class BoughLawSlot {
+public:
+    BoughLawSlot() = default;
+    explicit BoughLawSlot(std::shared_ptr<const BoughLawContext> context);
+    BoughLawSlot(const BoughLawSlot& other) : mContext(other.mContext) {}
+    BoughLawSlot(BoughLawSlot&& other) noexcept;
+    BoughLawSlot& operator=(BoughLawSlot other) noexcept;
+    ~BoughLawSlot();
+    /// Throws std::logic_error for a bough made without makeTracedBough.
+    const BoughLawContext& context() const;
+    /// Made on first use, from any thread.
+    BoughLawEvaluation& evaluation() const;
+
+private:
+    std::shared_ptr<const BoughLawContext> mContext;
+    mutable std::atomic<BoughLawEvaluation*> mEvaluation{nullptr};
+};
 
 /// What the scene says of one bough: what makeTracedBough prepares.
 struct BoughDescription {
@@ -77,12 +104,14 @@ struct BoughDescription {
 struct TracedBough {
     Vec3 base_cm, tip_cm, axis;  ///< axis: unit, base to tip; needles point towards the tip
     double length_cm = 0.0;
-    /// Where the cones end: the last cone's needles reach l cos(phi) past the tip. Cones and
-    /// needles (levels 1-2) are found up to here; the volume (level 3) spans base to tip, which
-    /// holds the same amount of needles (the layered region is that cylinder, sheared).
-    Vec3 conesEnd_cm;
-    /// Where the strip level 3 draws ends: tip_cm or conesEnd_cm, as the law's profiles say.
-    Vec3 stripEnd_cm;
+    /// How far past the tip the cones end: the last cone's needles reach l cos(phi) past it.
+    double conesReach_cm = 0.0;
+    /// Where the cones end. Cones and needles (levels 1-2) are found up to here; the volume
+    /// (level 3) spans base to tip, which holds the same amount of needles (the layered region
+    /// is that cylinder, sheared). Computed, not kept: 3.3 million boughs, 80 MB.
+    Vec3 conesEnd() const { return tip_cm + conesReach_cm * axis; }
+    /// Where the strip level 3 draws ends: tip_cm or conesEnd(), as the law's profiles say.
+    Vec3 stripEnd() const { return stripToConesEnd ? conesEnd() : tip_cm; }
     analytic::BoughGeometry geometry;  ///< needle parameters at mid-bough (section 3.1)
     double radius_cm = 0.0;            ///< R = l sin(phi)
     double layerOpacity = 0.0;         ///< A
@@ -97,17 +126,19 @@ struct TracedBough {
     Vec3 across{0.0};
     RearComposite rearComposite = RearComposite::Own;  ///< how the law's rear half composites
     bool shadesNeedles = false;  ///< level 3 reflects the law's diffuse and specular profiles
+    bool stripToConesEnd = false;  ///< the law's strip ends at conesEnd(), else at the tip
     unsigned seed = 0;          ///< drives the needles' azimuths at level 1
     int tree = -1;              ///< index of its tree in the scene's trees
 
-    /// The bough law's profiles seen from the camera, computed on first use, once, from any
-    /// thread: a bough that no cone meets at level 3 never pays for them.
-    const BoughView& view() const;
+    /// The bough law's profiles seen from the camera, computed on first use, from any thread:
+    /// a bough that no cone meets at level 3 never pays for them. A scene's boughs keep their
+    /// profiles up to a budget (TracedSceneParts::lawProfileBudget_bytes), the oldest dropped
+    /// first; one dropped is computed again, the same, when asked again. The pointer keeps it.
+    std::shared_ptr<const BoughView> view() const;
     /// The law's opacity of the whole bough seen from light `light`, across the light's strip
-    /// (what its shadow takes from light crossing it): on first use, once, as view().
-    const StripProfile& opacityFromLight(std::size_t light) const;
-    /// Their inputs and values, shared by copies of this bough, which must not change it.
-    std::shared_ptr<BoughLawEvaluation> law;
+    /// (what its shadow takes from light crossing it): on first use, kept as view()'s.
+    std::shared_ptr<const StripProfile> opacityFromLight(std::size_t light) const;
+    BoughLawSlot law;
 };
 
 /// Unit, orthogonal to the unit `axis` and to `towards`: the direction across the strip a
@@ -142,6 +173,8 @@ struct TracedScene {
     /// The bough law the boughs were made with: this scene's own (BoughLaw::fresh), which the
     /// boughs point to.
     std::shared_ptr<const BoughLaw> boughLaw;
+    /// What the boughs evaluate their law with (null for a scene built without laws).
+    std::shared_ptr<const BoughLawContext> lawContext;
     /// render.shadow_origin: where a bough hit's shadow stands for.
     ShadowOrigin shadowOrigin = ShadowOrigin::Needles;
 
@@ -188,7 +221,23 @@ struct TracedSceneParts {
     /// released after the build; treeCounts stays): the multiscale method reads only its
     /// boughs and branches, and a landscape's 10,000 trees take about 500 MB.
     bool grownTrees = true;
+    /// The memory the boughs' law profiles (TracedBough::view, opacityFromLight) may keep, in
+    /// bytes (`render --law-cache`; the largest value keeps all of them): a landscape's 1.3
+    /// million views and 1.6 million profiles from the light took 1.3 GB, though each is read
+    /// by the pixels near its bough and their shadow cones; the oldest dropped, some are
+    /// computed again (docs/architecture.md).
+    std::size_t lawProfileBudget_bytes = std::numeric_limits<std::size_t>::max();
 };
+
+/// How many of a kind of law profile the boughs of a scene computed (again, after being
+/// dropped) and dropped.
+struct ProfileCounts {
+    std::uint64_t computed = 0, dropped = 0;
+};
+struct LawProfileCounts {
+    ProfileCounts views, fromLights;
+};
+LawProfileCounts lawProfileCounts(const TracedScene& scene);
 
 /// Grows every tree and prepares the scene for its camera under the scene's bough law and
 /// layer model (scene.render.model), in parallel. Keeps a pointer to `scene`, which must
