@@ -424,7 +424,9 @@ TEST(MultiscaleTracer, BranchBeyondTheGroundIsNotShaded)
   "effects": ["diffuse", "shadows"]})", "buried.json");
     for (const double z : {-1.5, 1.5}) {
         TracedScene traced = buildTracedScene(scene);
-        traced.branches.push_back({Vec3(-20, 0, z), Vec3(20, 0, z), 1.0, Vec3(0.3)});
+        traced.barks.push_back(Vec3(0.3));
+        traced.branches.push_back(
+            {Vec3(-20, 0, z), Vec3(20, 0, z), 1.0, std::uint32_t(traced.barks.size() - 1)});
         // A conservative box, as a BVH node's may be: it reaches above the ground.
         Aabb box = cylinderBounds(Vec3(-20, 0, z), Vec3(20, 0, z), 1.0);
         box.grow(Vec3(0, -10, 3));

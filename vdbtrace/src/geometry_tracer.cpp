@@ -502,7 +502,7 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
             exponent = b.exponent;
             ++mStats.needleHits;
         } else {
-            albedo = mScene.branches[c.owner].albedo;
+            albedo = mScene.barks[mScene.branches[c.owner].bark];
             tree = mScene.branches[c.owner].tree;
             ++mStats.branchHits;
         }

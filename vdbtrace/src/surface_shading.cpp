@@ -118,7 +118,7 @@ bool SurfaceShading::branch(const ConeRay& ray, std::size_t index, double tMax, 
     const Vec3 axis = glm::normalize(br.tip_cm - br.base_cm);
     for (const Incident& light : lightAt(ray.origin + p.t * ray.direction, w, index)) {
         const double R = analytic::needleDiffuse(axis, light.towards, -ray.direction);
-        out.diffuse += c * br.albedo / analytic::kPi * light.irradiance * R;
+        out.diffuse += c * mScene.barks[br.bark] / analytic::kPi * light.irradiance * R;
         ++mStats.diffuseEvaluations;
     }
     return true;

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <deque>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <shared_mutex>
@@ -552,6 +553,15 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     }
     out.branches.resize(firstBranch.back());
     out.boughs.resize(firstBough.back());
+    // One bark albedo a species.
+    std::vector<std::uint32_t> barkOf(out.trees.size());
+    std::map<const scenes::Species*, std::uint32_t> barks;
+    for (std::size_t i = 0; i < out.trees.size(); ++i) {
+        const scenes::Species* species = grown(i).species;
+        const auto [at, fresh] = barks.emplace(species, std::uint32_t(out.barks.size()));
+        if (fresh) out.barks.push_back(scenes::barkColour(*species));
+        barkOf[i] = at->second;
+    }
     const auto context = lawContext(scene.camera.position_cm, out.lights, *law, layers, needs,
                                     parts.lawProfileBudget_bytes);
     if (parts.boughLaws) out.lawContext = context;
@@ -560,11 +570,10 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
         const bool moved = &tree != &out.trees[i];
         const Vec3 offset = moved ? offsetOf(i) : Vec3(0.0);
         const auto placed = [&](const Vec3& p) { return moved ? p + offset : p; };
-        const Vec3 bark = scenes::barkColour(*tree.species);
         for (std::size_t k = 0; k < tree.segments.size(); ++k) {
             const scenes::Segment& s = tree.segments[k];
             out.branches[firstBranch[i] + k] = {placed(s.base_cm), placed(s.tip_cm), s.radius_cm,
-                                                bark, int(i)};
+                                                barkOf[i], int(i)};
         }
         for (std::size_t k = 0; k < described[i].size(); ++k) {
             TracedBough& b = out.boughs[firstBough[i] + k];

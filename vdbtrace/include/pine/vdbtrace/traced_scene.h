@@ -42,7 +42,9 @@ struct Light {
 struct TracedBranch {
     Vec3 base_cm, tip_cm;
     double radius_cm = 0.1;
-    Vec3 albedo{0.25};
+    /// Its albedo: TracedScene::barks[bark] (one a species, not one a branch: 3.5 million
+    /// branches in a landscape).
+    std::uint32_t bark = 0;
     int tree = -1;  ///< index of its tree in the scene's trees
 };
 
@@ -62,7 +64,7 @@ struct BoughView {
     std::vector<BoughLighting> lighting;  ///< one per light
 };
 
-/// What every bough of a scene evaluates its law with, and the views its boughs keep
+/// What every bough of a scene evaluates its law with, and the law profiles its boughs keep
 /// (traced_scene.cpp).
 struct BoughLawContext;
 /// A bough's law profiles once computed (traced_scene.cpp).
@@ -108,7 +110,8 @@ struct TracedBough {
     double conesReach_cm = 0.0;
     /// Where the cones end. Cones and needles (levels 1-2) are found up to here; the volume
     /// (level 3) spans base to tip, which holds the same amount of needles (the layered region
-    /// is that cylinder, sheared). Computed, not kept: 3.3 million boughs, 80 MB.
+    /// is that cylinder, sheared). Computed, not kept: 40 bytes of each of a landscape's 3.3
+    /// million boughs.
     Vec3 conesEnd() const { return tip_cm + conesReach_cm * axis; }
     /// Where the strip level 3 draws ends: tip_cm or conesEnd(), as the law's profiles say.
     Vec3 stripEnd() const { return stripToConesEnd ? conesEnd() : tip_cm; }
@@ -167,6 +170,7 @@ struct TracedScene {
     std::vector<scenes::TreeCounts> treeCounts;  ///< one per tree of the scene, always
     std::vector<Light> lights;
     std::vector<TracedBranch> branches;  ///< primitive index i < branches.size()
+    std::vector<Vec3> barks{Vec3(0.25)};  ///< the branches' albedos (TracedBranch::bark)
     std::vector<TracedBough> boughs;     ///< primitive index branches.size() + j
     Bvh bvh;
     const LayerModel* layers = nullptr;  ///< how a layer stops a line (layer_model.h)
