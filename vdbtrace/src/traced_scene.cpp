@@ -375,9 +375,9 @@ std::shared_ptr<const BoughLawContext> lawContext(const Vec3& eye_cm,
                                                   const std::vector<Light>& lights,
                                                   const BoughLaw& law, const LayerModel& layers,
                                                   const BoughLawNeeds& needs,
-                                                  std::size_t viewBudget_bytes)
+                                                  std::size_t profileBudget_bytes)
 {
-    auto c = std::make_shared<BoughLawContext>(viewBudget_bytes);
+    auto c = std::make_shared<BoughLawContext>(profileBudget_bytes);
     c->law = &law;
     c->layers = &layers;
     c->needs = needs;
@@ -514,9 +514,14 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
         });
     }
     // The grown tree that tree i's boughs and branches are made from: its own, or its first
-    // tree's, moved by offsetOf(i).
+    // tree's, whose points placed(i) moves by offsetOf(i).
     const auto grown = [&](std::size_t i) -> const scenes::Tree& {
         return out.trees[parts.grownTrees ? i : firstOf(i)];
+    };
+    const auto placed = [&](std::size_t i) {
+        const bool moved = &grown(i) != &out.trees[i];
+        const Vec3 offset = moved ? offsetOf(i) : Vec3(0.0);
+        return [moved, offset](const Vec3& p) { return moved ? p + offset : p; };
     };
 
     // Each tree's boughs described in parallel, then made in place, tree by tree, in the
@@ -524,18 +529,15 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     std::vector<std::vector<BoughDescription>> described(out.trees.size());
     tbb::parallel_for(std::size_t(0), out.trees.size(), [&](std::size_t i) {
         const scenes::Tree& tree = grown(i);
-        const bool moved = &tree != &out.trees[i];
-        const Vec3 offset = moved ? offsetOf(i) : Vec3(0.0);
+        const auto place = placed(i);
         const scenes::Species& species = *tree.species;
         const std::vector<bake::BoughSpec> specs = bake::treeBoughs(tree);
         for (std::size_t j = 0; j < specs.size(); ++j) {
             if (!(glm::length(specs[j].tip_cm - specs[j].base_cm) > 0.0)) continue;
             BoughDescription d;
             d.spec = specs[j];
-            if (moved) {
-                d.spec.base_cm += offset;
-                d.spec.tip_cm += offset;
-            }
+            d.spec.base_cm = place(d.spec.base_cm);
+            d.spec.tip_cm = place(d.spec.tip_cm);
             d.specularWeight = species.needleSpecular;
             d.exponent = species.specularExponent;
             // A variant's copies bear its first tree's needles (geometry instances them).
@@ -567,12 +569,10 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     if (parts.boughLaws) out.lawContext = context;
     tbb::parallel_for(std::size_t(0), out.trees.size(), [&](std::size_t i) {
         const scenes::Tree& tree = grown(i);
-        const bool moved = &tree != &out.trees[i];
-        const Vec3 offset = moved ? offsetOf(i) : Vec3(0.0);
-        const auto placed = [&](const Vec3& p) { return moved ? p + offset : p; };
+        const auto place = placed(i);
         for (std::size_t k = 0; k < tree.segments.size(); ++k) {
             const scenes::Segment& s = tree.segments[k];
-            out.branches[firstBranch[i] + k] = {placed(s.base_cm), placed(s.tip_cm), s.radius_cm,
+            out.branches[firstBranch[i] + k] = {place(s.base_cm), place(s.tip_cm), s.radius_cm,
                                                 barkOf[i], int(i)};
         }
         for (std::size_t k = 0; k < described[i].size(); ++k) {
