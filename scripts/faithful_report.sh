@@ -5,9 +5,9 @@
 # method with the faithful models (the default) and with --paper. Prints, per render, the
 # foliage coverage (mean of the foliage AOV) and the foliage's own mean luminance (the
 # foliage_luminance AOV summed over the foliage AOV summed: what lies behind partly covered
-# pixels does not count), for the whole image and per tree (`vdbtrace diff` over the truth's
-# "tree" AOV: the median and the worst tree's bias, and how many trees are off by more than
-# 3%). A 64 spp needles render on another sample pattern (`--sample-seed 1`), measured against
+# pixels does not count), for the whole image and per tree (`vdbtrace diff`, each tree's
+# foliage summed fragment by fragment by each render: the median and the worst tree's bias,
+# and how many trees are off by more than 3%). A 64 spp needles render on another sample pattern (`--sample-seed 1`), measured against
 # the truth like the others, shows what a truth of that many samples would put into those
 # numbers: against 2048 spp, 256 spp needles are within 2.1% on every tree of the forest and
 # 64 spp within 5.4%.

@@ -119,6 +119,25 @@ exr_info "$work/g.exr" >"$work/info"
 grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, specular.Y, tree.Y$" "$work/info" \
     || fail "geometry EXR channels: $(grep 'channel list' "$work/info")"
 grep -q "samplesPerPixel: 2$" "$work/info" || fail "geometry EXR lacks samplesPerPixel 2"
+# Each render carries its trees' foliage summed fragment by fragment; `diff` judges each tree
+# by them: its biases are the two headers' ratios.
+"$vdbtrace" diff "$work/b.exr" "$work/g.exr" --out "$work/bd" 2>/dev/null || fail "diff failed"
+{ exr_info "$work/b.exr"; echo "--- reference"; cat "$work/info"; } >"$work/both"
+/usr/bin/python3 - "$work/both" "$work/bd/errors.json" <<'PY2' || fail "diff's per-tree biases are not the headers' sums'"
+import json, re, sys
+image, reference = open(sys.argv[1]).read().split("--- reference")
+def sums(text):
+    rows = json.loads(json.loads(re.search(r'pine:tree_foliage: (".*")', text).group(1)))
+    return {t: (c, l) for t, c, l in rows}
+a, b = sums(image), sums(reference)
+j = json.load(open(sys.argv[2]))
+assert j["tree_attribution"] == "fragments", j.get("tree_attribution")
+assert [r["tree"] for r in j["trees"]] == sorted(b), (j["trees"], b)
+for r in j["trees"]:
+    (ca, la), (cb, lb) = a[r["tree"]], b[r["tree"]]
+    assert abs(r["coverage_bias"] - (ca / cb - 1)) < 1e-12, r
+    assert abs(r["luminance_bias"] - ((la / ca) / (lb / cb) - 1)) < 1e-12, r
+PY2
 # --sample-seed 0 is the default pattern; another seed is another (independent) image. The
 # double-precision cylinders render what the native curves render but for rounding.
 "$vdbtrace" render "$src/scenes/bough.json" --method geometry --samples 2 --sample-seed 0 --out "$work/g0.exr" -q \

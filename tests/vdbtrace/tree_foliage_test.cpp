@@ -1,6 +1,7 @@
 // The "tree" AOV and the per-tree foliage measures (tree_foliage.h): each method names the tree
 // its foliage comes from, checked against each tree rendered alone; regions and sums checked
-// against direct computation on small images.
+// against direct computation on small images; the sums fragment by fragment
+// (tree_foliage_tally.h) against the AOVs, alone and together, and through an EXR header.
 #include "pine/vdbtrace/tree_foliage.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/fragment.h"
@@ -9,9 +10,13 @@
 #include "pine/vdbtrace/traced_scene.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <numeric>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -79,12 +84,14 @@ TEST(TreeFoliage, SumsOverEachRegion)
 }
 
 // The three firs at low resolution, all of them or only tree `only`: the others moved behind
-// the camera, so that every tree keeps its index and its needles.
-scenes::Scene threeFirs(int only = -1)
+// the camera, so that every tree keeps its index and its needles. `overlapping`: the middle
+// fir moved behind the near one's edge, so that some pixels show both.
+scenes::Scene threeFirs(int only = -1, bool overlapping = false)
 {
     scenes::Scene s = scenes::loadScene(std::string(PINE_SOURCE_DIR) + "/scenes/three-firs.json");
     s.camera.width = 128;
     s.camera.height = 96;
+    if (overlapping) s.trees[1].base_cm.x = -80.0;
     for (std::size_t i = 0; i < s.trees.size(); ++i) {
         if (only >= 0 && int(i) != only) s.trees[i].base_cm.y -= 1e5;
     }
@@ -173,6 +180,139 @@ TEST(TreeFoliage, TheFoliagesOwnLuminanceDoesNotSeeWhatLiesBehind)
             EXPECT_GT(pixels[0][k].luminance / pixels[1][k].luminance, 1.02);
         }
     }
+}
+
+TEST(TreeFoliage, ATreesSumsAreItsFragmentsWhereverItsPixelsLie)
+{
+    // Rendered alone, a tree's sums are the foliage AOVs' sums over the image (every foliage
+    // fragment is its). Among the others (two overlapping in the image), the pixels only its
+    // own render covers are wholly its (a lower bound of its coverage) and those its own render
+    // covers hold all of it (an upper bound); the trees' sums add up to the AOVs' whatever tree
+    // a pixel names; and a tree of black needles has no luminance, in the pixels it shares too.
+    for (const bool geometry : {false, true}) {
+        const auto render = [&](const scenes::Scene& s) {
+            GeometryOptions g;
+            g.samples = 4;
+            const TracedScene t = buildTracedScene(s);
+            return geometry ? renderGeometry(t, g) : renderMultiscale(t);
+        };
+        const auto sum = [](const std::vector<float>& v) {
+            return std::accumulate(v.begin(), v.end(), 0.0);
+        };
+        const char* name = geometry ? "geometry" : "multiscale";
+        const RenderResult whole = render(threeFirs(-1, true));
+        const std::vector<float>& foliage = whole.image.aovs.at("foliage");
+        ASSERT_EQ(whole.treeFoliage.size(), 3u) << name;
+        double coverage = 0.0, luminance = 0.0;
+        for (const TreeFoliageSum& t : whole.treeFoliage) {
+            coverage += t.coverage_px;
+            luminance += t.luminance;
+        }
+        EXPECT_NEAR(coverage / sum(foliage), 1.0, 1e-5) << name;
+        EXPECT_NEAR(luminance / sum(whole.image.aovs.at("foliage_luminance")), 1.0, 1e-5) << name;
+        std::vector<std::vector<float>> alone;
+        for (int i = 0; i < 3; ++i) {
+            const RenderResult r = render(threeFirs(i, true));
+            ASSERT_EQ(r.treeFoliage.size(), 1u) << name;
+            EXPECT_EQ(r.treeFoliage[0].tree, i);
+            EXPECT_NEAR(r.treeFoliage[0].coverage_px / sum(r.image.aovs.at("foliage")), 1.0, 1e-5);
+            EXPECT_NEAR(r.treeFoliage[0].luminance / sum(r.image.aovs.at("foliage_luminance")),
+                        1.0, 1e-5);
+            alone.push_back(r.image.aovs.at("foliage"));
+        }
+        for (int i = 0; i < 3; ++i) {
+            double only = 0.0, within = 0.0;
+            for (std::size_t p = 0; p < foliage.size(); ++p) {
+                int covering = 0;
+                for (const std::vector<float>& a : alone) covering += a[p] > 0.0f;
+                if (alone[std::size_t(i)][p] > 0.0f) {
+                    within += foliage[p];
+                    if (covering == 1) only += foliage[p];
+                }
+            }
+            const double own = whole.treeFoliage[std::size_t(i)].coverage_px;
+            std::printf("%s tree %d: %.2f px of foliage; its pixels alone %.2f, all it covers "
+                        "%.2f\n", name, i, own, only, within);
+            EXPECT_GE(own, only * (1.0 - 1e-5)) << name << " tree " << i;
+            EXPECT_LE(own, within * (1.0 + 1e-5)) << name << " tree " << i;
+        }
+        // The bounds must differ where the firs overlap, or they test nothing.
+        double shared = 0.0;
+        for (std::size_t p = 0; p < foliage.size(); ++p) {
+            shared += alone[0][p] > 0.0f && alone[1][p] > 0.0f ? foliage[p] : 0.0f;
+        }
+        EXPECT_GT(shared, 10.0) << name << ": the firs barely overlap";
+
+        // The middle fir's needles black: all the luminance, shared pixels too, is the near
+        // fir's and the far one's, none of it the middle one's.
+        scenes::Scene dark = threeFirs(-1, true);
+        dark.species["dark"] = dark.species.at(dark.trees[1].species);
+        dark.species["dark"].needleAlbedo = dark.species["dark"].needleSpecular = 0.0;
+        dark.trees[1].species = "dark";
+        const RenderResult d = render(dark);
+        ASSERT_EQ(d.treeFoliage.size(), 3u);
+        EXPECT_EQ(d.treeFoliage[1].luminance, 0.0) << name;
+        EXPECT_NEAR((d.treeFoliage[0].luminance + d.treeFoliage[2].luminance) /
+                        sum(d.image.aovs.at("foliage_luminance")),
+                    1.0, 1e-5)
+            << name;
+    }
+}
+
+TEST(TreeFoliage, ATreesSumsDoNotDependOnThreads)
+{
+    const TracedScene t = buildTracedScene(threeFirs());
+    std::vector<TreeFoliageSum> sums[2];
+    for (const int threads : {1, 2}) {
+        tbb::task_arena arena(threads);
+        arena.execute([&] { sums[threads - 1] = renderMultiscale(t).treeFoliage; });
+    }
+    ASSERT_EQ(sums[0].size(), 3u);
+    EXPECT_EQ(sums[0], sums[1]);
+}
+
+TEST(TreeFoliage, BiasesFromTheSumsOfTwoRenders)
+{
+    // Tree 0: 10% more coverage at half the luminance; tree 1: under the truth's 20 pixels,
+    // left out; tree 2: not in the image; tree 3: only in the image, not judged.
+    const std::vector<TreeFoliageSum> image{{0, 110.0, 27.5}, {3, 40.0, 4.0}};
+    const std::vector<TreeFoliageSum> truth{{0, 100.0, 50.0}, {1, 19.0, 5.0}, {2, 50.0, 10.0}};
+    const std::vector<TreeBias> b = treeBiases(image, truth);
+    ASSERT_EQ(b.size(), 2u);
+    EXPECT_EQ(b[0].truth.tree, 0);
+    EXPECT_NEAR(b[0].coverageBias, 0.1, 1e-12);
+    EXPECT_NEAR(b[0].luminanceBias, 27.5 / 110.0 / 0.5 - 1.0, 1e-12);
+    EXPECT_NEAR(b[0].image.luminance, 0.25, 1e-12);
+    EXPECT_EQ(b[1].truth.tree, 2);
+    EXPECT_EQ(b[1].coverageBias, -1.0);
+    EXPECT_EQ(b[1].luminanceBias, -1.0);
+    EXPECT_EQ(treeBiases(image, truth, 0.0).size(), 3u);
+}
+
+TEST(TreeFoliage, SumsRoundTripThroughAnExrHeader)
+{
+    // Ten thousand trees (a landscape's), random sums: back bit for bit.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1e4);
+    std::vector<TreeFoliageSum> sums;
+    for (int i = 0; i < 10000; ++i) sums.push_back({3 * i + 1, u(rng), u(rng) * 1e-3});
+    const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                       ("pine-tree-foliage-" +
+                                        std::to_string(std::random_device{}()) + ".exr");
+    writeExr(Image(2, 2), path, {{kTreeFoliageAttribute, treeFoliageText(sums)}});
+    Metadata header;
+    readExr(path, &header);
+    std::filesystem::remove(path);
+    const auto back = treeFoliageOf(header, path.string());
+    ASSERT_TRUE(back.has_value());
+    EXPECT_EQ(*back, sums);
+    EXPECT_FALSE(treeFoliageOf(Metadata{{"pine:method", std::string("multiscale")}}, "x"));
+
+    for (const char* bad : {"{", "{}", "[[1, 2]]", "[[-1, 2, 3]]", "[[2, 1, 1], [1, 1, 1]]",
+                            "[[1, -2, 3]]", "[[1.5, 2, 3]]", "[[1, \"a\", 3]]"}) {
+        EXPECT_THROW(parseTreeFoliage(bad, "image.exr"), ImageError) << bad;
+    }
+    EXPECT_THROW(treeFoliageOf(Metadata{{kTreeFoliageAttribute, 3}}, "x"), ImageError);
 }
 
 }  // namespace

@@ -125,12 +125,19 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
     }
     const Aovs aovs(image);
     const int samples = std::max(1, method.samplesPerPixel());
+    // Each tile's trees, summed in tile order once all are done.
+    const int tile = std::max(1, options.tileSize);
+    const int tilesX = (image.width + tile - 1) / tile;
+    std::vector<TreeFoliageTally> tileTrees(
+        std::size_t(tilesX) * std::size_t((image.height + tile - 1) / tile));
 
     // Tiles of the window; each pixel traced at its place in the frame, so a crop holds the
     // whole frame's pixels exactly.
-    forEachTile(image.width, image.height, options.tileSize, options.progress, result.stats,
+    forEachTile(image.width, image.height, tile, options.progress, result.stats,
                 [&](int tx0, int ty0, int tx1, int ty1, RenderStats& stats) {
         const std::unique_ptr<ShadingMethod::RayTracer> tracer = method.rayTracer(stats);
+        TreeFoliageTally& trees =
+            tileTrees[std::size_t(ty0 / tile) * std::size_t(tilesX) + std::size_t(tx0 / tile)];
         PixelSum pixel;
         for (int y = ty0 + w.y0; y < ty1 + w.y0; ++y) {
             for (int x = tx0 + w.x0; x < tx1 + w.x0; ++x) {
@@ -138,7 +145,7 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
                 pixel.clear();
                 for (int s = 0; s < samples; ++s) {
                     ++stats.coneRays;
-                    FrontToBack composite;
+                    FrontToBack composite(&trees, 1.0 / samples);
                     tracer->trace(method.sample(camera, x, y, s), composite);
                     pixel.add(composite.value());
                 }
@@ -152,6 +159,9 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
         }
     });
     result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    TreeFoliageTally trees;
+    for (const TreeFoliageTally& t : tileTrees) trees.add(t);
+    result.treeFoliage = trees.sums();
     // Finite inputs can still overflow (a light of 1e308): an error, never a NaN pixel.
     std::size_t bad = 0;
     for (const float v : image.rgba) bad += std::isfinite(v) ? 0 : 1;

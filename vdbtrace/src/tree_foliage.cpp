@@ -2,10 +2,13 @@
 
 #include "pine/vdbtrace/fragment.h"
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <deque>
 #include <map>
 #include <string>
+#include <variant>
 
 namespace pine::vdbtrace {
 namespace {
@@ -107,6 +110,69 @@ std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double 
         TreeBias t{a[k], b[k], a[k].coverage / b[k].coverage - 1.0,
                    b[k].luminance > 0.0 ? a[k].luminance / b[k].luminance - 1.0 : 0.0};
         out.push_back(t);
+    }
+    return out;
+}
+
+std::string treeFoliageText(const std::vector<TreeFoliageSum>& sums)
+{
+    nlohmann::json rows = nlohmann::json::array();
+    for (const TreeFoliageSum& t : sums) rows.push_back({t.tree, t.coverage_px, t.luminance});
+    return rows.dump();
+}
+
+std::vector<TreeFoliageSum> parseTreeFoliage(const std::string& text, const std::string& where)
+{
+    const auto bad = [&](const std::string& why) {
+        return ImageError(where + ": " + kTreeFoliageAttribute + " " + why);
+    };
+    const nlohmann::json rows = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (!rows.is_array()) throw bad("is not a JSON array");
+    std::vector<TreeFoliageSum> out;
+    for (const nlohmann::json& r : rows) {
+        if (!r.is_array() || r.size() != 3 || !r[0].is_number_integer() || !r[1].is_number() ||
+            !r[2].is_number()) {
+            throw bad("holds " + r.dump() + ", not [tree, coverage, luminance]");
+        }
+        const TreeFoliageSum t{r[0].get<int>(), r[1].get<double>(), r[2].get<double>()};
+        if (t.tree < 0 || !std::isfinite(t.coverage_px) || !(t.coverage_px >= 0.0) ||
+            !std::isfinite(t.luminance) || (!out.empty() && t.tree <= out.back().tree)) {
+            throw bad("holds " + r.dump() + ": trees must increase, sums be finite");
+        }
+        out.push_back(t);
+    }
+    return out;
+}
+
+std::optional<std::vector<TreeFoliageSum>> treeFoliageOf(const Metadata& metadata,
+                                                          const std::string& where)
+{
+    for (const auto& [key, value] : metadata) {
+        if (key != kTreeFoliageAttribute) continue;
+        const std::string* text = std::get_if<std::string>(&value);
+        if (!text) throw ImageError(where + ": " + kTreeFoliageAttribute + " is not text");
+        return parseTreeFoliage(*text, where);
+    }
+    return std::nullopt;
+}
+
+std::vector<TreeBias> treeBiases(const std::vector<TreeFoliageSum>& image,
+                                 const std::vector<TreeFoliageSum>& truth, double minCoverage)
+{
+    std::map<int, const TreeFoliageSum*> shown;
+    for (const TreeFoliageSum& t : image) shown[t.tree] = &t;
+    const auto foliage = [](const TreeFoliageSum& t) {
+        return TreeFoliage{t.tree, 0, t.coverage_px,
+                           t.coverage_px > 0.0 ? t.luminance / t.coverage_px : 0.0};
+    };
+    std::vector<TreeBias> out;
+    for (const TreeFoliageSum& t : truth) {
+        if (!(t.coverage_px >= minCoverage) || !(t.coverage_px > 0.0)) continue;
+        const auto it = shown.find(t.tree);
+        const TreeFoliage a = it != shown.end() ? foliage(*it->second) : TreeFoliage{t.tree};
+        const TreeFoliage b = foliage(t);
+        out.push_back({a, b, a.coverage / b.coverage - 1.0,
+                       b.luminance > 0.0 ? a.luminance / b.luminance - 1.0 : 0.0});
     }
     return out;
 }

@@ -347,6 +347,10 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         {"pine:threads", tbb::this_task_arena::max_concurrency()},
         {"pine:effects", effects.dump()},
         {"pine:units", "cm"}});
+    if (!result.treeFoliage.empty()) {
+        metadata.emplace_back(vdbtrace::kTreeFoliageAttribute,
+                              vdbtrace::treeFoliageText(result.treeFoliage));
+    }
     for (const auto& [key, value] : methodSettings.items()) {
         if (value.is_number_integer()) {
             metadata.emplace_back("pine:" + key, value.get<int>());
@@ -730,7 +734,9 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
     std::error_code ec;
     fs::create_directories(outDir, ec);
     io::checkWritable(outDir / "error.exr");
-    const vdbtrace::Image image = vdbtrace::readExr(a), reference = vdbtrace::readExr(b);
+    vdbtrace::Metadata imageHeader, referenceHeader;
+    const vdbtrace::Image image = vdbtrace::readExr(a, &imageHeader),
+                          reference = vdbtrace::readExr(b, &referenceHeader);
     const vdbtrace::ImageErrors errors = vdbtrace::compareImages(image, reference);
     const double shown = scale > 0.0 ? scale : std::max(errors.maxAbsolute, 1e-12);
     vdbtrace::writeExr(errors.error, outDir / "error.exr",
@@ -740,23 +746,31 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
     j["image"] = a.string();
     j["reference"] = b.string();
     j["png_scale"] = shown;
-    // Per tree, over the reference's trees (its "tree" AOV), where both images say so.
+    // Per tree: fragment by fragment where both renders summed their trees so
+    // (tree_foliage_tally.h), else over the regions of the reference's "tree" AOV.
     std::string worst;
-    if (reference.aovs.count("tree") && reference.aovs.count("foliage") &&
-        image.aovs.count("foliage")) {
-        const std::vector<vdbtrace::TreeBias> trees = vdbtrace::treeBiases(image, reference);
+    const auto imageTrees = vdbtrace::treeFoliageOf(imageHeader, a.string());
+    const auto referenceTrees = vdbtrace::treeFoliageOf(referenceHeader, b.string());
+    const bool byFragments = imageTrees && referenceTrees;
+    if (byFragments || (reference.aovs.count("tree") && reference.aovs.count("foliage") &&
+                        image.aovs.count("foliage"))) {
+        const std::vector<vdbtrace::TreeBias> trees =
+            byFragments ? vdbtrace::treeBiases(*imageTrees, *referenceTrees)
+                        : vdbtrace::treeBiases(image, reference);
+        j["tree_attribution"] = byFragments ? "fragments" : "regions";
         nlohmann::json rows = nlohmann::json::array();
         const vdbtrace::TreeBias* worstLuminance = nullptr;
         const vdbtrace::TreeBias* worstCoverage = nullptr;
         for (const vdbtrace::TreeBias& t : trees) {
-            rows.push_back({{"tree", t.truth.tree},
-                            {"pixels", t.truth.pixels},
-                            {"coverage", t.image.coverage},
-                            {"coverage_reference", t.truth.coverage},
-                            {"coverage_bias", t.coverageBias},
-                            {"luminance", t.image.luminance},
-                            {"luminance_reference", t.truth.luminance},
-                            {"luminance_bias", t.luminanceBias}});
+            nlohmann::json row = {{"tree", t.truth.tree},
+                                  {"coverage", t.image.coverage},
+                                  {"coverage_reference", t.truth.coverage},
+                                  {"coverage_bias", t.coverageBias},
+                                  {"luminance", t.image.luminance},
+                                  {"luminance_reference", t.truth.luminance},
+                                  {"luminance_bias", t.luminanceBias}};
+            if (!byFragments) row["pixels"] = t.truth.pixels;  // of its region
+            rows.push_back(row);
             if (!worstLuminance ||
                 std::abs(t.luminanceBias) > std::abs(worstLuminance->luminanceBias)) {
                 worstLuminance = &t;

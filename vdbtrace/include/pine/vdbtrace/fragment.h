@@ -4,6 +4,7 @@
 #pragma once
 
 #include "pine/vdbtrace/geometry.h"
+#include "pine/vdbtrace/tree_foliage_tally.h"
 
 #include <algorithm>
 #include <limits>
@@ -90,6 +91,14 @@ public:
     /// Accumulated coverage beyond which nothing behind can show.
     static constexpr double kOpaque = 0.999;
 
+    FrontToBack() = default;
+    /// Also tells `tally` each foliage fragment's part of the composite, times `sampleWeight`
+    /// (the sample's share of its pixel).
+    FrontToBack(TreeFoliageTally* tally, double sampleWeight)
+        : mTally(tally), mSampleWeight(sampleWeight)
+    {
+    }
+
     /// Adds `f` behind everything added so far. A method stops adding once opaque(): the
     /// multiscale method before each fragment, the reference before each voxel span.
     void add(const Fragment& f)
@@ -98,9 +107,11 @@ public:
         mValue.diffuse += (1.0 - mValue.alpha) * f.diffuse;
         mValue.specular += (1.0 - mValue.alpha) * f.specular;
         if (f.foliage) {
+            const double shown = (1.0 - mValue.alpha) * luminance(f.diffuse + f.specular);
             mValue.foliage += weight;
-            mValue.foliageLuminance += (1.0 - mValue.alpha) * luminance(f.diffuse + f.specular);
+            mValue.foliageLuminance += shown;
             mValue.trees.add(f.tree, weight);
+            if (mTally) mTally->add(f.tree, mSampleWeight * weight, mSampleWeight * shown);
         }
         if (f.level > 0) {
             mValue.levelSum += weight * f.level;
@@ -119,6 +130,8 @@ public:
 
 private:
     SampleValue mValue;
+    TreeFoliageTally* mTally = nullptr;
+    double mSampleWeight = 1.0;
 };
 
 }  // namespace pine::vdbtrace

@@ -3,8 +3,10 @@
 
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/render_stats.h"
+#include "pine/vdbtrace/tree_foliage_tally.h"
 
 #include <functional>
+#include <vector>
 
 namespace pine::vdbtrace {
 
@@ -37,6 +39,9 @@ struct RenderResult {
     RenderStats stats;
     double seconds = 0.0;      ///< wall clock, including what the method prepares first
     double prepSeconds = 0.0;  ///< of `seconds`, that preparation (BVH, bake, light grids)
+    /// Each tree's foliage, fragment by fragment (tree_foliage_tally.h); empty where the
+    /// method knows no trees (the reference's merged grids).
+    std::vector<TreeFoliageSum> treeFoliage;
 };
 
 }  // namespace pine::vdbtrace

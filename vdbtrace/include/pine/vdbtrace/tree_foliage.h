@@ -6,8 +6,11 @@
 #pragma once
 
 #include "pine/vdbtrace/image.h"
+#include "pine/vdbtrace/tree_foliage_tally.h"
 
 #include <cstddef>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -57,5 +60,23 @@ struct TreeBias {
 /// the AOV, else both as Pixels; trees whose truth covers
 /// fewer than `minCoverage` pixels (or none) are left out (their ratios are noise).
 std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double minCoverage = 20.0);
+
+/// The EXR header attribute a render's per-tree sums (RenderResult::treeFoliage) are written
+/// under, as JSON text [[tree, coverage_px, luminance], ...]: numbers written to round trip.
+inline constexpr const char* kTreeFoliageAttribute = "pine:tree_foliage";
+std::string treeFoliageText(const std::vector<TreeFoliageSum>& sums);
+/// Throws ImageError naming `where` if `text` is not what treeFoliageText writes.
+std::vector<TreeFoliageSum> parseTreeFoliage(const std::string& text, const std::string& where);
+/// The sums an EXR's header carries (readExr's metadata), if it carries them.
+std::optional<std::vector<TreeFoliageSum>> treeFoliageOf(const Metadata& metadata,
+                                                          const std::string& where);
+
+/// Every tree of `truth`, `image` against it, from each render's own sums fragment by fragment
+/// (the exact attribution; TreeBias::*.pixels is 0): coverage ratio - 1 and mean luminance
+/// ratio - 1. Trees whose truth covers fewer than `minCoverage` pixels are left out; a tree
+/// the image does not show counts with coverage and luminance 0 (both biases -100%).
+std::vector<TreeBias> treeBiases(const std::vector<TreeFoliageSum>& image,
+                                 const std::vector<TreeFoliageSum>& truth,
+                                 double minCoverage = 20.0);
 
 }  // namespace pine::vdbtrace
