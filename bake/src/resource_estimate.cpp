@@ -19,19 +19,25 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kGiB = 1024.0 * 1024.0 * 1024.0;
 
-// Bytes per item, from measured peaks (paper forest, README): an image pixel with its AOVs,
-// the EXR's interleaved copy and the previews; a branch or bough as the tracer holds it (its
-// profiles per light, its BVH node); a needle cylinder with Embree's BVH; a voxel of the six
+// Bytes per item, from the peaks of `vdbtrace render` measured 2026-12-04 (the paper forest,
+// its 1280 firs and the 10,000-fir landscape; docs/architecture.md, "Memory"): an image pixel
+// with its AOVs, the EXR's interleaved copy and the previews; a branch or bough as the tracer
+// holds it (its record, its share of the BVH, a bough's law evaluation); a bough's law
+// profiles (multiscale: the view of level 3, 790 bytes with one light, and the opacity seen
+// from each light, 200: the stats' law_profiles count them); a bough of the grown trees
+// geometry keeps for its instances; a needle cylinder with Embree's BVH; a voxel of the six
 // grids and a light grid.
 constexpr double kBytesPerPixel = 96.0;
-constexpr double kBytesPerBranch = 200.0;
-constexpr double kBytesPerBough = 800.0, kBytesPerBoughLight = 1200.0;
-constexpr double kBytesPerNeedle = 220.0;
-constexpr double kBytesPerVoxel = 80.0, kBytesPerVoxelLight = 8.0;
+constexpr double kBytesPerBranch = 110.0;
+constexpr double kBytesPerBough = 380.0;
+constexpr double kBytesPerBoughView = 800.0, kBytesPerBoughLight = 200.0;
+constexpr double kBytesPerGrownBough = 150.0;
+constexpr double kBytesPerNeedle = 140.0;
+constexpr double kBytesPerVoxel = 84.0, kBytesPerVoxelLight = 8.0;
 // A bake written in metres or in a tree's frame converts a copy of every grid while writing
 // (measured: 275 against 164 MiB on a 600k-voxel tree).
 constexpr double kBytesPerVoxelWritten = 190.0;
-constexpr double kProgramBytes = 150.0 * 1024 * 1024;  // its libraries, before any scene
+constexpr double kProgramBytes = 185.0 * 1024 * 1024;  // its libraries, before any scene
 constexpr const char* kProgram = "the program";
 
 using TreeSample = TreeTotals;  // of one grown tree per species
@@ -135,7 +141,8 @@ const ResourceEstimate::Part& ResourceEstimate::largest() const
 }
 
 ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
-                                double voxelSize_cm, double voxelsRead, bool instanceVariants)
+                                double voxelSize_cm, double voxelsRead, bool instanceVariants,
+                                double lawProfileBudget_bytes)
 {
     ResourceEstimate e;
     e.parts.push_back({kProgram, kProgramBytes});
@@ -147,9 +154,18 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
     const double lights = double(scene.pointLights.size() + scene.directionalLights.size());
     e.parts.push_back({count(double(scene.trees.size())) + " trees (" + count(trees.boughs) +
                            " boughs, " + count(trees.branches) + " branches)",
-                       trees.branches * kBytesPerBranch +
-                           trees.boughs * (kBytesPerBough + kBytesPerBoughLight * lights)});
-    if (method == "geometry") {
+                       trees.branches * kBytesPerBranch + trees.boughs * kBytesPerBough});
+    if (method == "multiscale") {
+        // At most every bough's, as many as the render meets (95% of the paper forest's, 40%
+        // of the landscape's), within the budget where one is given.
+        const double all = trees.boughs * (kBytesPerBoughView + kBytesPerBoughLight * lights);
+        const bool bounded = lawProfileBudget_bytes < all;
+        e.parts.push_back({bounded ? "the law profiles, within --law-cache"
+                                   : "the law profiles of up to " + count(trees.boughs) +
+                                         " boughs (--law-cache MIB bounds them)",
+                           bounded ? lawProfileBudget_bytes : all});
+    } else if (method == "geometry") {
+        e.parts.push_back({"grown trees", trees.boughs * kBytesPerGrownBough});
         std::vector<std::size_t> laidOut;  // the trees whose needles are cylinders of their own
         for (std::size_t i = 0; i < scene.trees.size(); ++i) {
             if (!instanceVariants || scene.trees[i].variantOf < 0) laidOut.push_back(i);

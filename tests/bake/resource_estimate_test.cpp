@@ -38,5 +38,31 @@ TEST(ResourceEstimate, OneTreePerSpeciesStandsForTheForest)
     EXPECT_NO_THROW(checkMemory(geometry, geometry.bytes() * 1.01, "x"));
 }
 
+TEST(ResourceEstimate, ALawCacheBoundsTheMultiscaleProfiles)
+{
+    // Every bough's profiles at most; a --law-cache budget below that replaces them, and one
+    // above it changes nothing.
+    const scenes::Scene scene =
+        scenes::loadScene(std::string(PINE_SOURCE_DIR) + "/scenes/paper-forest.json");
+    const auto profiles = [](const ResourceEstimate& e) {
+        for (const ResourceEstimate::Part& p : e.parts) {
+            if (p.what.find("law profiles") != std::string::npos) return p.bytes;
+        }
+        return -1.0;
+    };
+    const ResourceEstimate all = estimateRender(scene, "multiscale", 0.0);
+    const double kept = profiles(all);
+    ASSERT_GT(kept, 0.0);
+    const TreeTotals trees = estimateTrees(scene, {0});
+    EXPECT_GT(kept, 80 * trees.boughs * 500.0) << "a view and a profile from the light a bough";
+    const ResourceEstimate bounded = estimateRender(scene, "multiscale", 0.0, 0.0, true, 1e6);
+    EXPECT_EQ(profiles(bounded), 1e6);
+    EXPECT_NEAR(all.bytes() - bounded.bytes(), kept - 1e6, 1.0);
+    EXPECT_EQ(estimateRender(scene, "multiscale", 0.0, 0.0, true, 2.0 * kept).bytes(),
+              all.bytes());
+    // Only the multiscale method keeps them.
+    EXPECT_LT(profiles(estimateRender(scene, "geometry", 0.0)), 0.0);
+}
+
 }  // namespace
 }  // namespace pine::bake

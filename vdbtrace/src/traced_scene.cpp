@@ -102,9 +102,11 @@ public:
     void keep(std::shared_ptr<const void> profile, std::size_t bytes, Kind kind)
     {
         ++mCounts[kind].computed;
+        mCounts[kind].bytes += bytes;
         const std::lock_guard<std::mutex> lock(mMutex);
         mKept.push_back({std::move(profile), bytes, kind});
         mBytes += bytes;
+        mPeak = std::max(mPeak, mBytes);
         while (mBytes > mBudget && mKept.size() > 1) {
             mBytes -= mKept.front().bytes;
             ++mCounts[mKept.front().kind].dropped;
@@ -115,7 +117,13 @@ public:
     bool keepsAll() const { return mBudget == std::numeric_limits<std::size_t>::max(); }
     ProfileCounts counts(Kind kind) const
     {
-        return {mCounts[kind].computed.load(), mCounts[kind].dropped.load()};
+        return {mCounts[kind].computed.load(), mCounts[kind].dropped.load(),
+                mCounts[kind].bytes.load()};
+    }
+    std::size_t peakBytes()
+    {
+        const std::lock_guard<std::mutex> lock(mMutex);
+        return mPeak;
     }
     // Held shared while a bough's profile is read, alone while it is computed: one asked by
     // two threads at once is computed once.
@@ -131,11 +139,11 @@ private:
         Kind kind;
     };
     struct Counts {
-        std::atomic<std::uint64_t> computed{0}, dropped{0};
+        std::atomic<std::uint64_t> computed{0}, dropped{0}, bytes{0};
     };
     std::mutex mMutex;
     std::deque<Kept> mKept;  ///< oldest first
-    std::size_t mBytes = 0;
+    std::size_t mBytes = 0, mPeak = 0;
     const std::size_t mBudget;
     Counts mCounts[2];
     struct alignas(64) Guard {  // one a cache line: threads reading apart do not share one
@@ -246,8 +254,9 @@ BoughLawEvaluation& BoughLawSlot::evaluation() const
 LawProfileCounts lawProfileCounts(const TracedScene& scene)
 {
     if (!scene.lawContext) return {};
-    const LawProfileCache& cache = scene.lawContext->profiles;
-    return {cache.counts(LawProfileCache::kView), cache.counts(LawProfileCache::kFromLight)};
+    LawProfileCache& cache = scene.lawContext->profiles;
+    return {cache.counts(LawProfileCache::kView), cache.counts(LawProfileCache::kFromLight),
+            cache.peakBytes()};
 }
 
 namespace {

@@ -273,7 +273,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             bake::checkMemory(
                 bake::estimateRender(
                     scene, methodName, settings.voxelSize_cm, voxelsRead,
-                    settings.geometry.primitive == vdbtrace::NeedlePrimitive::Curve),
+                    settings.geometry.primitive == vdbtrace::NeedlePrimitive::Curve,
+                    lawCacheMiB > 0.0 ? lawCacheMiB * (1 << 20)
+                                      : std::numeric_limits<double>::infinity()),
                 bake::memoryLimit(maxMemoryGiB), sceneFile.string());
         },
         [&](scenes::Scene& scene) {
@@ -387,11 +389,13 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             }
             j["threads"] = tbb::this_task_arena::max_concurrency();
             const auto counted = [](const vdbtrace::ProfileCounts& c) {
-                return nlohmann::json{{"computed", c.computed}, {"dropped", c.dropped}};
+                return nlohmann::json{
+                    {"computed", c.computed}, {"dropped", c.dropped}, {"bytes", c.bytes}};
             };
             if (profiles.views.computed + profiles.fromLights.computed > 0) {
                 j["law_profiles"] = {{"views", counted(profiles.views)},
-                                     {"from_lights", counted(profiles.fromLights)}};
+                                     {"from_lights", counted(profiles.fromLights)},
+                                     {"peak_bytes", profiles.peakBytes}};
             }
             j.update(methodSettings);
             vdbtrace::writeJsonAtomically(j, statsFile);

@@ -5,6 +5,7 @@
 
 #include "pine/scenes/scene.h"
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -31,15 +32,17 @@ TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size
 
 /// The memory a render of `scene` by method `method` ("multiscale", "reference", "geometry")
 /// will need, within a factor of about 1.5 of the peaks measured (docs/vdbtrace.md): the image
-/// and its outputs, the trees as the tracer holds them, and the method's own (explicit needles;
-/// the reference's voxels of `voxelSize_cm` with the light reaching each, or with
-/// `voxelsRead` > 0, grids already read, only that light). Each species is grown once, for its
-/// first placement, which stands for all of its placements.
+/// and its outputs, the trees as the tracer holds them, and the method's own (the multiscale
+/// law profiles of every bough, or `lawProfileBudget_bytes` if less; the grown trees and the
+/// explicit needles; the reference's voxels of `voxelSize_cm` with the light reaching each, or
+/// with `voxelsRead` > 0, grids already read, only that light). Each species is grown once,
+/// for its first placement, which stands for all of its placements.
 /// With `instanceVariants` (the geometry method with Embree's curves), the needles of a
 /// scatter's variant count once, whatever the trees that copy it (TreePlacement::variantOf).
 ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
                                 double voxelSize_cm, double voxelsRead = 0.0,
-                                bool instanceVariants = true);
+                                bool instanceVariants = true,
+                                double lawProfileBudget_bytes = std::numeric_limits<double>::infinity());
 
 /// The memory `vdbtrace compare` will need: the largest of its methods' renders (the reference
 /// at `smallestVoxel_cm`), with `images` renders kept at once for the report.

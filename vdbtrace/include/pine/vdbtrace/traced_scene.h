@@ -237,9 +237,11 @@ struct TracedSceneParts {
 /// dropped) and dropped.
 struct ProfileCounts {
     std::uint64_t computed = 0, dropped = 0;
+    std::uint64_t bytes = 0;  ///< of all computed, each as the cache counts it
 };
 struct LawProfileCounts {
     ProfileCounts views, fromLights;
+    std::uint64_t peakBytes = 0;  ///< the most the cache kept at once
 };
 LawProfileCounts lawProfileCounts(const TracedScene& scene);
 
