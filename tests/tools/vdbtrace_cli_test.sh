@@ -119,6 +119,32 @@ exr_info "$work/g.exr" >"$work/info"
 grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, specular.Y, tree.Y$" "$work/info" \
     || fail "geometry EXR channels: $(grep 'channel list' "$work/info")"
 grep -q "samplesPerPixel: 2$" "$work/info" || fail "geometry EXR lacks samplesPerPixel 2"
+# Without --law-cache, a multiscale render whose law profiles alone would not fit --max-memory
+# keeps them within what the rest leaves (at least 16 MiB): the same image, the cache within it;
+# with less left, or with --law-cache given, it is refused as before.
+pf="$src/scenes/paper-forest.json"
+total=$("$vdbtrace" render "$pf" --resolution 320x240 --max-memory 0.0001 --out "$work/m.exr" 2>&1 \
+    | sed -n 's/.*(\([0-9]*\) MiB in all).*/\1/p')
+[ -n "$total" ] || fail "the refusal names no estimate in all"
+limit=$(/usr/bin/python3 -c "print(($total - 6) / 1024)")
+"$vdbtrace" render "$pf" --resolution 320x240 --out "$work/m0.exr" -q || fail "paper forest failed"
+"$vdbtrace" render "$pf" --resolution 320x240 --max-memory "$limit" --out "$work/m1.exr" \
+    --stats "$work/m1.json" 2>"$work/err" || fail "a render its law profiles can fit was refused: $(tail -1 "$work/err")"
+budget=$(sed -n 's/.*law profiles within \([0-9]*\) MiB.*/\1/p' "$work/err")
+[ -n "$budget" ] || fail "the render did not say it bounds its law profiles: $(cat "$work/err")"
+idiff -q -fail 0 -failpercent 0 "$work/m0.exr" "$work/m1.exr" >/dev/null 2>&1 \
+    || fail "bounded law profiles changed the image: $(idiff "$work/m0.exr" "$work/m1.exr" | tail -2)"
+/usr/bin/python3 - "$work/m1.json" "$budget" <<'PY2' || fail "the law profiles were not kept within the budget"
+import json, sys
+p = json.load(open(sys.argv[1]))["law_profiles"]
+assert p["peak_bytes"] <= int(sys.argv[2]) * 2**20, p
+assert p["views"]["dropped"] + p["from_lights"]["dropped"] > 0, p
+PY2
+expect_error "too little left for law profiles" 2 "max-memory" -- render "$pf" --resolution 320x240 \
+    --max-memory "$(/usr/bin/python3 -c "print(($total - 20) / 1024)")" --out "$work/m2.exr"
+expect_error "a --law-cache too large" 2 "max-memory" -- render "$pf" --resolution 320x240 \
+    --max-memory "$limit" --law-cache 200 --out "$work/m2.exr"
+
 # Each render carries its trees' foliage summed fragment by fragment; `diff` judges each tree
 # by them: its biases are the two headers' ratios.
 "$vdbtrace" diff "$work/b.exr" "$work/g.exr" --out "$work/bd" 2>/dev/null || fail "diff failed"

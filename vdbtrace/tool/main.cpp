@@ -209,6 +209,11 @@ struct FrameOverrides {
     vdbtrace::PixelWindow crop;     ///< --crop (empty: the whole frame)
 };
 
+constexpr double kMiB = 1024.0 * 1024.0;
+/// The least a render keeps its law profiles within, by itself, to fit --max-memory: below it
+/// most would be computed again and again.
+constexpr double kLeastLawCache_bytes = 16.0 * kMiB;
+
 int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs,
            vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles,
@@ -217,7 +222,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
 {
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
     vdbtrace::TracedSceneParts parts = method.parts;
-    if (lawCacheMiB > 0.0) parts.lawProfileBudget_bytes = std::size_t(lawCacheMiB * (1 << 20));
+    if (lawCacheMiB > 0.0) parts.lawProfileBudget_bytes = std::size_t(lawCacheMiB * kMiB);
     // The extension decides the format: only EXR holds the render (its PNG goes beside it).
     std::string extension = out.extension().string();
     for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -270,13 +275,27 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             }
             const double voxelsRead =
                 baked ? double(baked->layerOpacity->activeVoxelCount()) : 0.0;
-            bake::checkMemory(
-                bake::estimateRender(
+            const auto estimate = [&](double lawProfiles_bytes) {
+                return bake::estimateRender(
                     scene, methodName, settings.voxelSize_cm, voxelsRead,
                     settings.geometry.primitive == vdbtrace::NeedlePrimitive::Curve,
-                    lawCacheMiB > 0.0 ? lawCacheMiB * (1 << 20)
-                                      : std::numeric_limits<double>::infinity()),
-                bake::memoryLimit(maxMemoryGiB), sceneFile.string());
+                    lawProfiles_bytes);
+            };
+            const double limit = bake::memoryLimit(maxMemoryGiB);
+            bake::ResourceEstimate needs = estimate(
+                lawCacheMiB > 0.0 ? lawCacheMiB * kMiB : std::numeric_limits<double>::infinity());
+            // Without --law-cache, profiles that would not fit are kept within what is left,
+            // as --law-cache would keep them: the same image, some recomputed.
+            const double left = limit - estimate(0.0).bytes();
+            if (methodName == "multiscale" && !(lawCacheMiB > 0.0) && needs.bytes() > limit &&
+                left >= kLeastLawCache_bytes) {
+                parts.lawProfileBudget_bytes = std::size_t(left);
+                needs = estimate(left);
+                tool::info() << "vdbtrace: keeping the boughs' law profiles within "
+                             << bake::formatBytes(left) << " (as --law-cache would) to stay "
+                             << "under --max-memory " << bake::formatBytes(limit) << '\n';
+            }
+            bake::checkMemory(needs, limit, sceneFile.string());
         },
         [&](scenes::Scene& scene) {
             if (frame.width > 0) {
@@ -912,8 +931,9 @@ int main(int argc, char** argv)
     double lawCacheMiB = 0.0;  // 0: keep every profile
     renderCmd->add_option("--law-cache", lawCacheMiB,
                           "multiscale: MiB the boughs' law profiles (views, shadows) may keep "
-                          "(default: all); the oldest are dropped and computed again, the same, "
-                          "if asked again (a landscape: 1.3 GB kept, 64 MiB enough)")
+                          "(default: all, or what --max-memory leaves them); the oldest are "
+                          "dropped and computed again, the same, if asked again (a landscape: "
+                          "1.3 GB kept, 64 MiB enough)")
         ->check(CLI::Range(1.0, 1e7));
 
     bool scaling = false;
