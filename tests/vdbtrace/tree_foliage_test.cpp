@@ -309,7 +309,8 @@ TEST(TreeFoliage, SumsRoundTripThroughAnExrHeader)
     EXPECT_FALSE(treeFoliageOf(Metadata{{"pine:method", std::string("multiscale")}}, "x"));
 
     for (const char* bad : {"{", "{}", "[[1, 2]]", "[[-1, 2, 3]]", "[[2, 1, 1], [1, 1, 1]]",
-                            "[[1, -2, 3]]", "[[1.5, 2, 3]]", "[[1, \"a\", 3]]"}) {
+                            "[[1, -2, 3]]", "[[1.5, 2, 3]]", "[[1, \"a\", 3]]",
+                            "[[4294967297, 1, 1]]"}) {
         EXPECT_THROW(parseTreeFoliage(bad, "image.exr"), ImageError) << bad;
     }
     EXPECT_THROW(treeFoliageOf(Metadata{{kTreeFoliageAttribute, 3}}, "x"), ImageError);

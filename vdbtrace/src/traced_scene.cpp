@@ -120,7 +120,7 @@ public:
         return {mCounts[kind].computed.load(), mCounts[kind].dropped.load(),
                 mCounts[kind].bytes.load()};
     }
-    std::size_t peakBytes()
+    std::size_t peakBytes() const
     {
         const std::lock_guard<std::mutex> lock(mMutex);
         return mPeak;
@@ -141,7 +141,7 @@ private:
     struct Counts {
         std::atomic<std::uint64_t> computed{0}, dropped{0}, bytes{0};
     };
-    std::mutex mMutex;
+    mutable std::mutex mMutex;
     std::deque<Kept> mKept;  ///< oldest first
     std::size_t mBytes = 0, mPeak = 0;
     const std::size_t mBudget;
@@ -254,7 +254,7 @@ BoughLawEvaluation& BoughLawSlot::evaluation() const
 LawProfileCounts lawProfileCounts(const TracedScene& scene)
 {
     if (!scene.lawContext) return {};
-    LawProfileCache& cache = scene.lawContext->profiles;
+    const LawProfileCache& cache = scene.lawContext->profiles;
     return {cache.counts(LawProfileCache::kView), cache.counts(LawProfileCache::kFromLight),
             cache.peakBytes()};
 }

@@ -5,7 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <deque>
+#include <limits>
 #include <map>
 #include <string>
 #include <variant>
@@ -134,8 +136,12 @@ std::vector<TreeFoliageSum> parseTreeFoliage(const std::string& text, const std:
             !r[2].is_number()) {
             throw bad("holds " + r.dump() + ", not [tree, coverage, luminance]");
         }
-        const TreeFoliageSum t{r[0].get<int>(), r[1].get<double>(), r[2].get<double>()};
-        if (t.tree < 0 || !std::isfinite(t.coverage_px) || !(t.coverage_px >= 0.0) ||
+        const std::int64_t tree = r[0].get<std::int64_t>();
+        if (tree < 0 || tree > std::numeric_limits<int>::max()) {
+            throw bad("holds " + r.dump() + ": no tree index");
+        }
+        const TreeFoliageSum t{int(tree), r[1].get<double>(), r[2].get<double>()};
+        if (!std::isfinite(t.coverage_px) || !(t.coverage_px >= 0.0) ||
             !std::isfinite(t.luminance) || (!out.empty() && t.tree <= out.back().tree)) {
             throw bad("holds " + r.dump() + ": trees must increase, sums be finite");
         }

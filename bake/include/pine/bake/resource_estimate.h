@@ -39,10 +39,10 @@ TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size
 /// for its first placement, which stands for all of its placements.
 /// With `instanceVariants` (the geometry method with Embree's curves), the needles of a
 /// scatter's variant count once, whatever the trees that copy it (TreePlacement::variantOf).
-ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& method,
-                                double voxelSize_cm, double voxelsRead = 0.0,
-                                bool instanceVariants = true,
-                                double lawProfileBudget_bytes = std::numeric_limits<double>::infinity());
+ResourceEstimate estimateRender(
+    const scenes::Scene& scene, const std::string& method, double voxelSize_cm,
+    double voxelsRead = 0.0, bool instanceVariants = true,
+    double lawProfileBudget_bytes = std::numeric_limits<double>::infinity());
 
 /// The memory `vdbtrace compare` will need: the largest of its methods' renders (the reference
 /// at `smallestVoxel_cm`), with `images` renders kept at once for the report.
