@@ -285,10 +285,13 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             bake::ResourceEstimate needs = estimate(
                 lawCacheMiB > 0.0 ? lawCacheMiB * kMiB : std::numeric_limits<double>::infinity());
             // Without --law-cache, profiles that would not fit are kept within what is left,
-            // as --law-cache would keep them: the same image, some recomputed.
-            const double left = limit - estimate(0.0).bytes();
-            if (methodName == "multiscale" && !(lawCacheMiB > 0.0) && needs.bytes() > limit &&
-                left >= kLeastLawCache_bytes) {
+            // as --law-cache would keep them: the same image, some recomputed. (Each estimate
+            // grows a tree a species: the one without profiles only where it is needed.)
+            const double left = methodName == "multiscale" && !(lawCacheMiB > 0.0) &&
+                                        needs.bytes() > limit
+                                    ? limit - estimate(0.0).bytes()
+                                    : 0.0;
+            if (left >= kLeastLawCache_bytes) {
                 parts.lawProfileBudget_bytes = std::size_t(left);
                 needs = estimate(left);
                 tool::info() << "vdbtrace: keeping the boughs' law profiles within "
