@@ -126,18 +126,15 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
     const Aovs aovs(image);
     const int samples = std::max(1, method.samplesPerPixel());
     // Each tile's trees, summed in tile order once all are done.
-    const int tile = std::max(1, options.tileSize);
-    const int tilesX = (image.width + tile - 1) / tile;
     std::vector<TreeFoliageTally> tileTrees(
-        std::size_t(tilesX) * std::size_t((image.height + tile - 1) / tile));
+        std::size_t(tileCount(image.width, image.height, options.tileSize)));
 
     // Tiles of the window; each pixel traced at its place in the frame, so a crop holds the
     // whole frame's pixels exactly.
-    forEachTile(image.width, image.height, tile, options.progress, result.stats,
-                [&](int tx0, int ty0, int tx1, int ty1, RenderStats& stats) {
+    forEachTile(image.width, image.height, options.tileSize, options.progress, result.stats,
+                [&](int k, int tx0, int ty0, int tx1, int ty1, RenderStats& stats) {
         const std::unique_ptr<ShadingMethod::RayTracer> tracer = method.rayTracer(stats);
-        TreeFoliageTally& trees =
-            tileTrees[std::size_t(ty0 / tile) * std::size_t(tilesX) + std::size_t(tx0 / tile)];
+        TreeFoliageTally& trees = tileTrees[std::size_t(k)];
         PixelSum pixel;
         for (int y = ty0 + w.y0; y < ty1 + w.y0; ++y) {
             for (int x = tx0 + w.x0; x < tx1 + w.x0; ++x) {

@@ -13,24 +13,31 @@
 
 namespace pine::vdbtrace {
 
-/// Calls renderTile(x0, y0, x1, y1, stats) for every tile of `tile` x `tile` pixels of a
-/// width x height image ([x0, x1) x [y0, y1)), in parallel. Each tile counts into its own
-/// stats, summed into `total`: integers, so the sum does not depend on the order in which the
-/// tiles finish, and each pixel is computed alone, so neither does the image. `progress`
-/// hears the fraction done, in steps of 2%.
+/// How many tiles of `tile` x `tile` pixels (at least 1 x 1) a width x height image has.
+inline int tileCount(int width, int height, int tile)
+{
+    tile = std::max(1, tile);
+    return ((width + tile - 1) / tile) * ((height + tile - 1) / tile);
+}
+
+/// Calls renderTile(k, x0, y0, x1, y1, stats) for every tile k in [0, tileCount) of `tile` x
+/// `tile` pixels of a width x height image ([x0, x1) x [y0, y1)), in scanline order of the
+/// tiles, in parallel. Each tile counts into its own stats, summed into `total`: integers, so
+/// the sum does not depend on the order in which the tiles finish, and each pixel is computed
+/// alone, so neither does the image. `progress` hears the fraction done, in steps of 2%.
 template <class RenderTile>
 void forEachTile(int width, int height, int tile, const std::function<void(double)>& progress,
                  RenderStats& total, RenderTile&& renderTile)
 {
     tile = std::max(1, tile);
-    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
-    const int tiles = tilesX * tilesY;
+    const int tilesX = (width + tile - 1) / tile;
+    const int tiles = tileCount(width, height, tile);
     std::mutex statsMutex;
     std::atomic<int> done{0}, reported{0};
     tbb::parallel_for(0, tiles, [&](int k) {
         RenderStats stats;
         const int x0 = (k % tilesX) * tile, y0 = (k / tilesX) * tile;
-        renderTile(x0, y0, std::min(x0 + tile, width), std::min(y0 + tile, height), stats);
+        renderTile(k, x0, y0, std::min(x0 + tile, width), std::min(y0 + tile, height), stats);
         {
             std::lock_guard<std::mutex> lock(statsMutex);
             total += stats;
