@@ -146,6 +146,25 @@ void Bvh::build(const std::vector<Vec3>& centres, const Bounds& bounds, std::uin
     setReach(reach);
 }
 
+std::vector<std::uint32_t> Bvh::queryOrder() const
+{
+    std::vector<std::uint32_t> order;
+    order.reserve(mIndices.size());
+    if (mNodes.empty()) return order;
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {  // as query() walks, children pushed first then second
+        const Node& node = mNodes[stack.back()];
+        stack.pop_back();
+        if (node.count > 0) {
+            for (std::uint32_t i = 0; i < node.count; ++i) order.push_back(mIndices[node.first + i]);
+        } else {
+            stack.push_back(node.first);
+            stack.push_back(node.first + 1);
+        }
+    }
+    return order;
+}
+
 Aabb Bvh::bounds() const
 {
     Aabb box;

@@ -2,6 +2,7 @@
 
 #include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/ground_hit.h"
+#include "pine/vdbtrace/light_columns.h"
 
 #include <glm/geometric.hpp>
 
@@ -31,7 +32,7 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
     // Each point's transmittance so far.
     thread_local std::vector<double> T;
     T.assign(at.points.size(), 1.0);
-    scene.bvh.query(ray, tMax + behind, [&](std::uint32_t index) {
+    const auto occluder = [&](std::uint32_t index) {
         if (index == self) return true;
         const bool branch = scene.isBranch(index);
         if (!branch && !throughBoughs) return true;
@@ -50,22 +51,37 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         // The footprint's width across the occluder's strip (ShadowSamples::footprintNormal).
         const double tilt = glm::dot(n, at.footprintNormal);
         const double w = pointWidth * ray.width(p.t) * std::sqrt(std::max(0.0, 1.0 - tilt * tilt));
-        std::shared_ptr<const StripProfile> fromLight;  // the bough's, once a point reads it
+        const double R = branch ? scene.branches[index].radius_cm : scene.bough(index).radius_cm;
+        // A line farther than this from the axis misses the strip over its footprint: it
+        // reads 0 (stripCoverage, StripProfile::overFootprint), kept a hair wide of rounding.
+        const double misses = (R + 0.5 * std::max(w, 0.0)) * (1.0 + 1e-12);
+        std::shared_ptr<const StripProfile> fromLight;  // the bough's, once a point meets it
         bool dark = true;  // every point: nothing further shows
         for (std::size_t k = 0; k < T.size(); ++k) {
             const ShadowSamples::Point& q = at.points[k];
             if (p.t < tMax - q.towardsLight_cm) {  // else the occluder lies beyond this point
                 const double g = gap + along * q.offset_cm + aside * q.sideways_cm;
-                if (!branch && !fromLight) fromLight = scene.bough(index).opacityFromLight(light);
-                const double alpha =
-                    branch ? stripCoverage(g, scene.branches[index].radius_cm, w)
-                           : fromLight->overFootprint(g, scene.bough(index).radius_cm, w);
-                T[k] *= 1.0 - alpha;
+                if (std::abs(g) < misses) {
+                    if (!branch && !fromLight) {
+                        fromLight = scene.bough(index).opacityFromLight(light);
+                    }
+                    const double alpha = branch ? stripCoverage(g, R, w)
+                                                : fromLight->overFootprint(g, R, w);
+                    T[k] *= 1.0 - alpha;
+                }
             }
             dark = dark && T[k] < 1e-4;
         }
         return !dark;
-    });
+    };
+    if (const LightColumns* columns = scene.columns(light)) {
+        // Every occluder that can shade a point lies within this of x's line (its strip's
+        // half-width more): a point's line at most `reach` off it, read over at most the
+        // cone's width.
+        columns->query(x, 0.5 * ray.width(tMax + behind) + reach, behind, occluder);
+    } else {
+        scene.bvh.query(ray, tMax + behind, occluder);
+    }
     double sum = 0.0, weight = 0.0;
     for (std::size_t k = 0; k < T.size(); ++k) {
         sum += at.points[k].weight * T[k];

@@ -8,6 +8,7 @@
 #include "pine/support/registry.h"
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/layer_model.h"
+#include "pine/vdbtrace/light_columns.h"
 
 #include <glm/geometric.hpp>
 #include <tbb/parallel_for.h>
@@ -458,6 +459,29 @@ Sphere primitiveBall(const TracedScene& scene, std::size_t primitive)
     return cylinderSphere(c.base, c.end, c.radius_cm);
 }
 
+struct LightColumnsSet {
+    explicit LightColumnsSet(std::size_t lights) : once(lights), columns(lights) {}
+    std::vector<std::once_flag> once;
+    std::vector<std::unique_ptr<LightColumns>> columns;
+};
+
+const LightColumns* TracedScene::columns(std::size_t light) const
+{
+    if (!lightColumns || light >= lights.size() || !lights[light].directional) return nullptr;
+    LightColumnsSet& set = *lightColumns;
+    std::call_once(set.once[light], [&] {
+        const std::size_t count = branches.size() + boughs.size();
+        set.columns[light] = LightColumns::build(
+            count,
+            [&](std::size_t i) {
+                const PrimitiveCylinder c = primitiveCylinder(*this, i);
+                return LightColumns::Primitive{c.base, c.end, c.radius_cm};
+            },
+            bvh.queryOrder(), lights[light].towardsLight, kLightColumnsMax_bytes);
+    });
+    return set.columns[light].get();
+}
+
 void indexPrimitives(TracedScene& scene)
 {
     // The multiscale tracer flags a primitive's index with the top bit of 32 (kAtEntry).
@@ -470,6 +494,7 @@ void indexPrimitives(TracedScene& scene)
         box = cylinderBounds(c.base, c.end, c.radius_cm);
         ball = cylinderSphere(c.base, c.end, c.radius_cm);
     });
+    scene.lightColumns = std::make_shared<LightColumnsSet>(scene.lights.size());
 }
 
 TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts& parts)

@@ -134,6 +134,10 @@ public:
         }
     }
 
+    /// The primitives in the order query() visits those it visits: ranks 0, 1, ... of a query
+    /// that meets every node.
+    std::vector<std::uint32_t> queryOrder() const;
+
     /// The root's box (rounded outwards to single precision).
     Aabb bounds() const;
     bool empty() const { return mNodes.empty(); }

@@ -164,6 +164,10 @@ enum class ShadowOrigin {
     Bough,    ///< levels 2-3 read the bough's own shadows, once per frame (bough_shadows.h)
 };
 
+class LightColumns;
+/// Each light's LightColumns, made on first use (traced_scene.cpp).
+struct LightColumnsSet;
+
 struct TracedScene {
     const scenes::Scene* scene = nullptr;
     std::vector<scenes::Tree> trees;  ///< empty unless TracedSceneParts::grownTrees
@@ -181,6 +185,15 @@ struct TracedScene {
     std::shared_ptr<const BoughLawContext> lawContext;
     /// render.shadow_origin: where a bough hit's shadow stands for.
     ShadowOrigin shadowOrigin = ShadowOrigin::Needles;
+
+    /// Made with bvh (indexPrimitives): see columns().
+    std::shared_ptr<LightColumnsSet> lightColumns;
+
+    /// Light `light`'s shadow cones' columns (light_columns.h), made on first use; null for a
+    /// point light, or where they would take more than kLightColumnsMax_bytes (the cones then
+    /// walk the BVH, to the same result).
+    const LightColumns* columns(std::size_t light) const;
+    static constexpr std::size_t kLightColumnsMax_bytes = std::size_t(96) << 20;
 
     bool isBranch(std::size_t primitive) const { return primitive < branches.size(); }
     const TracedBough& bough(std::size_t primitive) const

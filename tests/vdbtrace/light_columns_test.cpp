@@ -1,0 +1,166 @@
+// A directional light's shadow cones find their occluders in columns across the light
+// (light_columns.h): every primitive within reach, in the BVH query's order, so that each
+// transmittance is the same product as through the BVH, to the bit.
+#include "pine/scenes/scene.h"
+#include "pine/vdbtrace/bvh.h"
+#include "pine/vdbtrace/light_columns.h"
+#include "pine/vdbtrace/multiscale_tracer.h"
+#include "pine/vdbtrace/surface_shading.h"
+#include "pine/vdbtrace/traced_scene.h"
+
+#include "test_scenes.h"
+
+#include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+
+namespace pine::vdbtrace {
+namespace {
+
+TEST(Bvh, QueryOrderIsTheOrderAQueryMeetingEveryNodeVisitsIn)
+{
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-50.0, 50.0);
+    std::vector<Aabb> boxes;
+    for (int i = 0; i < 300; ++i) {
+        const Vec3 a(u(rng), u(rng), u(rng));
+        boxes.push_back(cylinderBounds(a, a + Vec3(u(rng), u(rng), u(rng)) * 0.1, 0.5));
+    }
+    const Bvh bvh(boxes);
+    // A cone so wide that its margin holds every node.
+    const ConeRay ray{Vec3(0.0, 0.0, -1000.0), Vec3(0.0, 0.0, 1.0), 10.0};
+    std::vector<std::uint32_t> visited;
+    bvh.query(ray, 1e9, [&](std::uint32_t i) { visited.push_back(i); });
+    EXPECT_EQ(visited, bvh.queryOrder());
+    EXPECT_EQ(std::set<std::uint32_t>(visited.begin(), visited.end()).size(), boxes.size());
+}
+
+// The distance from the line through x along L to segment a-b, when they are seen along L.
+double distanceAcross(const Vec3& x, const Vec3& L, const Vec3& a, const Vec3& b)
+{
+    const auto flat = [&](const Vec3& p) { return p - glm::dot(p, L) * L; };
+    const Vec3 fa = flat(a - x), fb = flat(b - x), d = fb - fa;
+    const double length2 = glm::dot(d, d);
+    const double f = length2 > 0.0 ? std::clamp(-glm::dot(fa, d) / length2, 0.0, 1.0) : 0.0;
+    return glm::length(fa + f * d);
+}
+
+TEST(LightColumns, YieldEveryPrimitiveWithinReachOnceInTheBvhsOrder)
+{
+    // Random sticks (some along the light, some across it), random tubes; the columns must
+    // yield each stick within the tube's radius of its line and not beyond the point, and
+    // should leave out most of the others.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const Vec3 L = glm::normalize(Vec3(-0.5, -0.6, 0.8));
+    std::vector<LightColumns::Primitive> sticks;
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 base(60.0 * u(rng), 60.0 * u(rng), 30.0 * u(rng) + 30.0);
+        const Vec3 along = i % 10 == 0 ? L : glm::normalize(Vec3(u(rng), u(rng), u(rng)));
+        sticks.push_back({base, base + (2.0 + 6.0 * (u(rng) + 1.0)) * along,
+                          0.05 + 1.0 * (u(rng) + 1.0)});
+    }
+    std::vector<Aabb> boxes;
+    for (const auto& s : sticks) boxes.push_back(cylinderBounds(s.base, s.end, s.radius_cm));
+    const Bvh bvh(boxes);
+    const std::vector<std::uint32_t> order = bvh.queryOrder();
+    std::vector<std::size_t> rankOf(sticks.size());
+    for (std::size_t r = 0; r < order.size(); ++r) rankOf[order[r]] = r;
+    const auto columns = LightColumns::build(
+        sticks.size(), [&](std::size_t i) { return sticks[i]; }, order, L, std::size_t(1) << 30);
+    ASSERT_TRUE(columns);
+    std::size_t yielded = 0, expected = 0;
+    for (int q = 0; q < 2000; ++q) {
+        const Vec3 x(70.0 * u(rng), 70.0 * u(rng), 40.0 * u(rng) + 30.0);
+        const double radius = 0.1 + 4.0 * (u(rng) + 1.0), beyond = 2.0 * (u(rng) + 1.0);
+        std::vector<std::uint32_t> got;
+        columns->query(x, radius, beyond, [&](std::uint32_t i) {
+            got.push_back(i);
+            return true;
+        });
+        for (std::size_t k = 1; k < got.size(); ++k) {
+            ASSERT_LT(rankOf[got[k - 1]], rankOf[got[k]]) << "query " << q;
+        }
+        const std::set<std::uint32_t> found(got.begin(), got.end());
+        for (std::size_t i = 0; i < sticks.size(); ++i) {
+            const auto& s = sticks[i];
+            const double nearest =
+                std::min(-glm::dot(s.base, L), -glm::dot(s.end, L)) - s.radius_cm;
+            const bool within = distanceAcross(x, L, s.base, s.end) <= s.radius_cm + radius &&
+                                nearest <= -glm::dot(x, L) + beyond;
+            if (within) {
+                ++expected;
+                EXPECT_TRUE(found.count(std::uint32_t(i))) << "query " << q << ", stick " << i;
+            }
+        }
+        yielded += got.size();
+        // A visit returning false ends the query.
+        int calls = 0;
+        columns->query(x, radius, beyond, [&](std::uint32_t) { return ++calls < 2; });
+        EXPECT_EQ(calls, std::min<int>(2, int(got.size())));
+    }
+    EXPECT_GT(expected, 1000u);
+    EXPECT_LT(double(yielded), 1.5 * double(expected));
+    // Too little room: none made.
+    EXPECT_FALSE(LightColumns::build(
+        sticks.size(), [&](std::size_t i) { return sticks[i]; }, order, L, 1000));
+}
+
+TEST(LightColumns, ShadowConesReadTheSameThroughColumnsAsThroughTheBvh)
+{
+    const scenes::Scene scene = scenes::parseScene(
+        test::firScene(R"("diffuse", "shadows", "self_shadowing")", 48, 36), "test.json");
+    TracedScene traced = buildTracedScene(scene);
+    ASSERT_EQ(traced.lights.size(), 2u);
+    const std::size_t sun = traced.lights[0].directional ? 0 : 1;
+    ASSERT_TRUE(traced.lights[sun].directional);
+    EXPECT_NE(traced.columns(sun), nullptr);
+    EXPECT_EQ(traced.columns(1 - sun), nullptr);  // a point light's cones fan out
+
+    // Shadow cones from random points among the boughs, each with points spread about it.
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<Vec3> at;
+    std::vector<ShadowSamples> samples;
+    for (int i = 0; i < 400; ++i) {
+        const TracedBough& b = traced.boughs[std::size_t((u(rng) + 1.0) * 0.5 *
+                                                         double(traced.boughs.size() - 1))];
+        at.push_back(b.base_cm + (u(rng) + 1.0) * (b.tip_cm - b.base_cm) +
+                     b.radius_cm * Vec3(u(rng), u(rng), u(rng)));
+        ShadowSamples s;
+        s.across = glm::normalize(Vec3(u(rng), u(rng), 0.1));
+        s.sideways = glm::normalize(glm::cross(traced.lights[sun].towardsLight, s.across));
+        for (int k = 0; k < 6; ++k) {
+            s.points.push_back({2.0 * u(rng), 1.0 + u(rng), 2.0 * u(rng), 2.0 * u(rng)});
+        }
+        samples.push_back(s);
+    }
+    const auto shadows = [&](const TracedScene& s) {
+        std::vector<double> T;
+        for (std::size_t i = 0; i < at.size(); ++i) {
+            const double footprint = 0.2 + 2.0 * (1.0 + std::sin(double(i)));
+            T.push_back(shadowConeTransmittance(s, at[i], sun, footprint, kNoPrimitive, true,
+                                                &samples[i]));
+            T.push_back(shadowConeTransmittance(s, at[i], sun, footprint, kNoPrimitive, false));
+        }
+        return T;
+    };
+    const std::vector<double> through = shadows(traced);
+    const RenderResult a = renderMultiscale(traced, {});
+    traced.lightColumns.reset();  // every cone walks the BVH
+    ASSERT_EQ(traced.columns(sun), nullptr);
+    const std::vector<double> walked = shadows(traced);
+    EXPECT_EQ(through, walked);
+    EXPECT_LT(*std::min_element(walked.begin(), walked.end()), 0.5);  // some are shaded
+    const RenderResult b = renderMultiscale(traced, {});
+    EXPECT_EQ(a.image.rgba, b.image.rgba);
+    EXPECT_EQ(a.image.aovs, b.image.aovs);
+    EXPECT_EQ(a.stats.shadowRays, b.stats.shadowRays);
+}
+
+}  // namespace
+}  // namespace pine::vdbtrace

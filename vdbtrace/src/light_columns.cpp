@@ -1,0 +1,130 @@
+#include "pine/vdbtrace/light_columns.h"
+
+#include "pine/analytic/direction.h"
+
+#include <limits>
+#include <numeric>
+
+namespace pine::vdbtrace {
+namespace {
+
+float roundedDown(double x)
+{
+    const float f = float(x);
+    return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+float roundedUp(double x)
+{
+    const float f = float(x);
+    return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+}  // namespace
+
+std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
+                                                  const std::function<Primitive(std::size_t)>& at,
+                                                  const std::vector<std::uint32_t>& order,
+                                                  const Vec3& towardsLight, std::size_t maxBytes)
+{
+    if (count == 0 || order.size() != count) return nullptr;
+    std::unique_ptr<LightColumns> out(new LightColumns);
+    LightColumns& c = *out;
+    c.mTowardsLight = towardsLight;
+    c.mAcross[0] = analytic::anyPerpendicular(towardsLight);
+    c.mAcross[1] = glm::cross(towardsLight, c.mAcross[0]);
+    c.mShadows.resize(count);
+    c.mIndexOf.resize(count);
+    std::vector<float> depths(count);
+    std::vector<double> radii(count);
+    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    double hi[2] = {-lo[0], -lo[1]};
+    for (std::size_t rank = 0; rank < count; ++rank) {
+        const std::uint32_t index = order[rank];
+        const Primitive p = at(index);
+        Shadow& s = c.mShadows[rank];
+        for (int k = 0; k < 2; ++k) {
+            const double a = c.across(p.base, k), b = c.across(p.end, k);
+            s.a[k] = float(a);
+            s.b[k] = float(b);
+            lo[k] = std::min(lo[k], std::min(a, b) - p.radius_cm);
+            hi[k] = std::max(hi[k], std::max(a, b) + p.radius_cm);
+        }
+        s.radius = roundedUp(p.radius_cm);
+        depths[rank] = roundedDown(std::min(c.depth(p.base), c.depth(p.end)) - p.radius_cm);
+        radii[rank] = p.radius_cm;
+        c.mIndexOf[rank] = index;
+    }
+    // Cells about three times a typical primitive's radius: a bough's cones' reach, so that
+    // a shadow tube as wide as a pixel's footprint reads one to four cells.
+    std::vector<double> sorted = radii;
+    std::nth_element(sorted.begin(), sorted.begin() + long(count / 2), sorted.end());
+    c.mCell_cm = std::max(3.0 * sorted[count / 2], 1e-3);
+    const auto cellsAlong = [&](int k) {
+        return std::max(1.0, std::ceil((hi[k] - lo[k]) / c.mCell_cm));
+    };
+    // Never more cells than primitives: a wide scene of few primitives gets wider cells.
+    while (cellsAlong(0) * cellsAlong(1) > double(std::max<std::size_t>(count, 1024))) {
+        c.mCell_cm *= 2.0;
+    }
+    for (int k = 0; k < 2; ++k) {
+        c.mOrigin[k] = lo[k];
+        c.mCells[k] = int(cellsAlong(k));
+    }
+    const auto cellRange = [&](const Shadow& s, double radius, int k, int& from, int& to) {
+        // Grown by the floats' rounding, as a query's reach is.
+        const double grown = radius + 1e-6 * (std::abs(s.a[k]) + std::abs(s.b[k]) + 1.0);
+        const double a = std::min(s.a[k], s.b[k]) - grown, b = std::max(s.a[k], s.b[k]) + grown;
+        from = std::max(0, int(std::floor((a - c.mOrigin[k]) / c.mCell_cm)));
+        to = std::min(c.mCells[k] - 1, int(std::floor((b - c.mOrigin[k]) / c.mCell_cm)));
+    };
+    // Each primitive goes into every cell its projected axis, grown by its radius, may cross
+    // (its box across the light).
+    const std::size_t cells = std::size_t(c.mCells[0]) * std::size_t(c.mCells[1]);
+    std::vector<std::uint32_t> perCell(cells + 1, 0);
+    std::size_t entries = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        for (std::size_t rank = 0; rank < count; ++rank) {
+            int from[2], to[2];
+            for (int k = 0; k < 2; ++k) cellRange(c.mShadows[rank], radii[rank], k, from[k], to[k]);
+            for (int j = from[1]; j <= to[1]; ++j) {
+                for (int i = from[0]; i <= to[0]; ++i) {
+                    const std::size_t cell = std::size_t(j) * std::size_t(c.mCells[0]) + i;
+                    if (pass == 0) {
+                        ++perCell[cell + 1];
+                        ++entries;
+                    } else {
+                        c.mEntries[c.mFirst[cell] + perCell[cell]++] =
+                            Entry{depths[rank], std::uint32_t(rank)};
+                    }
+                }
+            }
+        }
+        if (pass == 0) {
+            const std::size_t bytes = entries * sizeof(Entry) + count * sizeof(Shadow) +
+                                      count * sizeof(std::uint32_t) +
+                                      (cells + 1) * sizeof(std::uint32_t);
+            if (bytes > maxBytes || entries >= std::size_t(UINT32_MAX)) return nullptr;
+            std::partial_sum(perCell.begin(), perCell.end(), perCell.begin());
+            c.mFirst.assign(perCell.begin(), perCell.end());
+            c.mEntries.resize(entries);
+            std::fill(perCell.begin(), perCell.end(), 0u);
+        }
+    }
+    // Each cell nearest the light first, so that a query stops at the point's depth.
+    for (std::size_t cell = 0; cell < cells; ++cell) {
+        std::sort(c.mEntries.begin() + c.mFirst[cell], c.mEntries.begin() + c.mFirst[cell + 1],
+                  [](const Entry& a, const Entry& b) {
+                      return a.depth != b.depth ? a.depth < b.depth : a.rank < b.rank;
+                  });
+    }
+    return out;
+}
+
+std::size_t LightColumns::bytes() const
+{
+    return sizeof(*this) + mFirst.capacity() * sizeof(std::uint32_t) +
+           mEntries.capacity() * sizeof(Entry) + mShadows.capacity() * sizeof(Shadow) +
+           mIndexOf.capacity() * sizeof(std::uint32_t);
+}
+
+}  // namespace pine::vdbtrace
