@@ -32,6 +32,9 @@ constexpr double kBytesPerBranch = 110.0;
 constexpr double kBytesPerBough = 380.0;
 constexpr double kBytesPerBoughView = 800.0, kBytesPerBoughLight = 200.0;
 constexpr double kBytesPerGrownBough = 150.0;
+// A directional light's shadow columns, per branch or bough (64 on the paper forest), made
+// only within kColumnsMaxBytes (TracedScene::kLightColumnsMax_bytes, which the tracer keeps).
+constexpr double kBytesPerColumnPrimitive = 64.0, kColumnsMaxBytes = 96.0 * 1024 * 1024;
 constexpr double kBytesPerNeedle = 140.0;
 constexpr double kBytesPerVoxel = 84.0, kBytesPerVoxelLight = 8.0;
 // A bake written in metres or in a tree's frame converts a copy of every grid while writing
@@ -155,6 +158,11 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
     e.parts.push_back({count(double(scene.trees.size())) + " trees (" + count(trees.boughs) +
                            " boughs, " + count(trees.branches) + " branches)",
                        trees.branches * kBytesPerBranch + trees.boughs * kBytesPerBough});
+    const double columns = (trees.branches + trees.boughs) * kBytesPerColumnPrimitive;
+    if ((method == "multiscale" || method == "reference") && scene.effects.shadows &&
+        !scene.directionalLights.empty() && columns <= kColumnsMaxBytes) {
+        e.parts.push_back({"shadow columns", columns * double(scene.directionalLights.size())});
+    }
     if (method == "multiscale") {
         // At most every bough's, as many as the render meets (95% of the paper forest's, 40%
         // of the landscape's), within the budget where one is given.

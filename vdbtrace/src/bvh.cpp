@@ -12,18 +12,6 @@ namespace pine::vdbtrace {
 
 namespace {
 
-// The nearest float at or below (above) x.
-float roundedDown(double x)
-{
-    const float f = float(x);
-    return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
-}
-float roundedUp(double x)
-{
-    const float f = float(x);
-    return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
-}
-
 std::size_t oneBallPerBox(const std::vector<Aabb>& boxes, const std::vector<Sphere>& balls)
 {
     if (boxes.size() != balls.size()) {

@@ -6,20 +6,6 @@
 #include <numeric>
 
 namespace pine::vdbtrace {
-namespace {
-
-float roundedDown(double x)
-{
-    const float f = float(x);
-    return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
-}
-float roundedUp(double x)
-{
-    const float f = float(x);
-    return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
-}
-
-}  // namespace
 
 std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
                                                   const std::function<Primitive(std::size_t)>& at,
@@ -70,13 +56,7 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
         c.mOrigin[k] = lo[k];
         c.mCells[k] = int(cellsAlong(k));
     }
-    const auto cellRange = [&](const Shadow& s, double radius, int k, int& from, int& to) {
-        // Grown by the floats' rounding, as a query's reach is.
-        const double grown = radius + 1e-6 * (std::abs(s.a[k]) + std::abs(s.b[k]) + 1.0);
-        const double a = std::min(s.a[k], s.b[k]) - grown, b = std::max(s.a[k], s.b[k]) + grown;
-        from = std::max(0, int(std::floor((a - c.mOrigin[k]) / c.mCell_cm)));
-        to = std::min(c.mCells[k] - 1, int(std::floor((b - c.mOrigin[k]) / c.mCell_cm)));
-    };
+
     // Each primitive goes into every cell its projected axis, grown by its radius, may cross
     // (its box across the light).
     const std::size_t cells = std::size_t(c.mCells[0]) * std::size_t(c.mCells[1]);
@@ -85,7 +65,7 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
     for (int pass = 0; pass < 2; ++pass) {
         for (std::size_t rank = 0; rank < count; ++rank) {
             int from[2], to[2];
-            for (int k = 0; k < 2; ++k) cellRange(c.mShadows[rank], radii[rank], k, from[k], to[k]);
+            for (int k = 0; k < 2; ++k) c.cellRange(c.mShadows[rank], k, from[k], to[k]);
             for (int j = from[1]; j <= to[1]; ++j) {
                 for (int i = from[0]; i <= to[0]; ++i) {
                     const std::size_t cell = std::size_t(j) * std::size_t(c.mCells[0]) + i;

@@ -482,6 +482,14 @@ const LightColumns* TracedScene::columns(std::size_t light) const
     return set.columns[light].get();
 }
 
+std::size_t lightColumnsBytes(const TracedScene& scene)
+{
+    std::size_t bytes = 0;
+    if (!scene.lightColumns) return bytes;
+    for (const auto& columns : scene.lightColumns->columns) bytes += columns ? columns->bytes() : 0;
+    return bytes;
+}
+
 void indexPrimitives(TracedScene& scene)
 {
     // The multiscale tracer flags a primitive's index with the top bit of 32 (kAtEntry).

@@ -350,6 +350,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     const vdbtrace::RenderResult result = method.render(loaded->traced, settings, options);
     rendering.finish();
     const vdbtrace::LawProfileCounts profiles = vdbtrace::lawProfileCounts(loaded->traced);
+    const std::size_t columnsBytes = vdbtrace::lightColumnsBytes(loaded->traced);
     // What is written is the image alone: the traced scene (most of a landscape's memory) goes
     // before the files are made.
     loaded->traced = vdbtrace::TracedScene();
@@ -419,6 +420,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                                      {"from_lights", counted(profiles.fromLights)},
                                      {"peak_bytes", profiles.peakBytes}};
             }
+            if (columnsBytes > 0) j["shadow_columns_bytes"] = columnsBytes;
             j.update(methodSettings);
             vdbtrace::writeJsonAtomically(j, statsFile);
         }

@@ -74,6 +74,18 @@ inline double stripCoverage(double gap, double halfWidth, double w)
     return std::clamp(overlap / w, 0.0, 1.0);
 }
 
+/// The nearest float at or below (above) x: single-precision bounds that still hold x.
+inline float roundedDown(double x)
+{
+    const float f = float(x);
+    return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+inline float roundedUp(double x)
+{
+    const float f = float(x);
+    return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
 /// The ray's interval inside a solid finite cylinder (segment a-b, radius r): false if none.
 bool intersectCylinder(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius,
                        double& tIn, double& tOut);

@@ -258,6 +258,9 @@ struct LawProfileCounts {
 };
 LawProfileCounts lawProfileCounts(const TracedScene& scene);
 
+/// The memory the lights' columns made so far take (TracedScene::columns), in bytes.
+std::size_t lightColumnsBytes(const TracedScene& scene);
+
 /// Grows every tree and prepares the scene for its camera under the scene's bough law and
 /// layer model (scene.render.model), in parallel. Keeps a pointer to `scene`, which must
 /// outlive the result. Throws InputError for an unknown law or model, naming the scene's key.
