@@ -173,7 +173,15 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
                                          " boughs (--law-cache MIB bounds them)",
                            bounded ? lawProfileBudget_bytes : all});
     } else if (method == "geometry") {
-        e.parts.push_back({"grown trees", trees.boughs * kBytesPerGrownBough});
+        // Each variant grown once, at its first tree, while the boughs are made.
+        std::vector<std::size_t> grown;
+        for (std::size_t i = 0; i < scene.trees.size(); ++i) {
+            if (scene.trees[i].variantOf < 0) grown.push_back(i);
+        }
+        const double grownBoughs = grown.size() < scene.trees.size()
+                                       ? sumTrees(scene, grown).boughs
+                                       : trees.boughs;
+        e.parts.push_back({"grown trees", grownBoughs * kBytesPerGrownBough});
         std::vector<std::size_t> laidOut;  // the trees whose needles are cylinders of their own
         for (std::size_t i = 0; i < scene.trees.size(); ++i) {
             if (!instanceVariants || scene.trees[i].variantOf < 0) laidOut.push_back(i);

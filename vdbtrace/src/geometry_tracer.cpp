@@ -551,7 +551,10 @@ std::vector<long long> variantsOf(const TracedScene& scene, NeedlePrimitive prim
 {
     const std::vector<scenes::TreePlacement>& trees = scene.scene->trees;
     std::vector<long long> variant(trees.size(), -1);
-    if (primitive != NeedlePrimitive::Curve || trees.size() != scene.trees.size()) return variant;
+    // A scene built without its trees' counts (by hand, in tests) says nothing of variants.
+    if (primitive != NeedlePrimitive::Curve || trees.size() != scene.treeCounts.size()) {
+        return variant;
+    }
     std::vector<long long> index(trees.size(), -1);  // of a first tree's variant
     for (std::size_t i = 0; i < trees.size(); ++i) {
         const long long first = trees[i].variantOf;

@@ -79,7 +79,7 @@ const std::vector<RenderMethod>& renderMethods()
          describeReference, referenceRays, false, false, TracedSceneParts{}},
         {"geometry", "explicit needle cylinders, point samples (the ground truth)", geometry,
          describeGeometry, geometrySamples, false, true,
-         TracedSceneParts{.primitiveIndex = false, .boughLaws = false}},
+         TracedSceneParts{.primitiveIndex = false, .boughLaws = false, .grownTrees = false}},
     };
     return methods;
 }

@@ -235,8 +235,9 @@ struct TracedSceneParts {
     bool primitiveIndex = true;  ///< TracedScene::bvh (else empty)
     bool boughLaws = true;       ///< each bough's law evaluation (else view() throws)
     /// TracedScene::trees, the grown trees the boughs and branches were made from (else
-    /// released after the build; treeCounts stays): the multiscale method reads only its
-    /// boughs and branches, and a landscape's 10,000 trees take about 500 MB.
+    /// released after the build; treeCounts stays): the multiscale and geometry methods read
+    /// only the boughs and branches, and a landscape's 10,000 trees take about 500 MB. Only
+    /// the reference bakes from them.
     bool grownTrees = true;
     /// The memory the boughs' law profiles (TracedBough::view, opacityFromLight) may keep, in
     /// bytes (`render --law-cache`; the largest value keeps all of them): a landscape's 1.3
