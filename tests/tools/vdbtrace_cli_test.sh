@@ -324,6 +324,30 @@ PY
 /usr/bin/python3 -c 'import json, sys
 j = json.load(open(sys.argv[1]))
 assert j["resolution"] == [32, 24], j["resolution"]' "$work/bench-res.json" || fail "bench --resolution: not 32x24"
+# bench --law-cache: the multiscale runs keep their law profiles within it, as render does:
+# with 1 MiB some are dropped and computed again, never more than it kept at once; without,
+# none is dropped.
+for cache in "" "--law-cache 1"; do
+  # shellcheck disable=SC2086
+  "$vdbtrace" bench "$work/small-firs.json" --resolution 160x120 --geometry-samples 0 $cache \
+      --json "$work/bench-cache${cache:+d}.json" >"$work/bench-cache.out" 2>"$work/err" \
+      || fail "bench ${cache:-without --law-cache}: $(tail -1 "$work/err")"
+done
+/usr/bin/python3 - "$work/bench-cached.json" "$work/bench-cache.json" <<'PY' \
+    || fail "bench --law-cache: $(cat "$work/bench-cache.out")"
+import json, sys
+cached, kept = (json.load(open(f))["multiscale"] for f in sys.argv[1:3])
+assert cached["law_cache_mib"] == 1 and "law_cache_mib" not in kept, cached
+c, k = cached["law_profiles"], kept["law_profiles"]
+assert k["views"]["dropped"] == 0 and k["from_lights"]["dropped"] == 0, k
+assert k["views"]["computed"] > 0, k
+assert c["views"]["dropped"] + c["from_lights"]["dropped"] > 0, c
+assert c["views"]["computed"] >= k["views"]["computed"], (c, k)
+assert k["peak_bytes"] > 1.05 * 1024 * 1024 >= c["peak_bytes"], (c, k)  # one profile over
+assert c["from_lights"]["computed"] > k["from_lights"]["computed"], (c, k)
+PY
+expect_error "bench --law-cache below 1 MiB" 2 "law-cache" -- \
+    bench "$work/small-firs.json" --law-cache 0.5
 expect_error "bench --grow without a folder" 2 "grow-dir" -- bench "$work/small-firs.json" --grow resolution
 expect_error "bench --grow, no scatter" 2 "no \"scatter\"" -- \
     bench "$work/small-firs.json" --grow trees-region --grow-dir "$work/grow-none"

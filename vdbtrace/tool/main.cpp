@@ -449,19 +449,25 @@ std::string machineDescription();
 // own preparation, as the geometry's Embree BVH, included).
 struct BenchRun {
     vdbtrace::RenderResult result;
+    vdbtrace::LawProfileCounts profiles;  ///< multiscale: the law profiles it computed
     double wallSeconds = 0.0, cpuSeconds = 0.0, buildSeconds = 0.0;
     std::size_t trees = 0, boughs = 0;
     double needles = 0.0;  ///< expected count (cones times needles per cone)
 };
 
+// `lawCacheMiB` > 0 bounds a multiscale render's law profiles as `render --law-cache` does.
 BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
-                  const vdbtrace::MethodSettings& settings, const std::string& label)
+                  const vdbtrace::MethodSettings& settings, const std::string& label,
+                  double lawCacheMiB)
 {
     using Clock = std::chrono::steady_clock;
     BenchRun run;
     const auto built = Clock::now();
-    const vdbtrace::TracedScene traced =
-        vdbtrace::buildTracedScene(scene, vdbtrace::renderMethod(method).parts);
+    vdbtrace::TracedSceneParts parts = vdbtrace::renderMethod(method).parts;
+    if (method == "multiscale" && lawCacheMiB > 0.0) {
+        parts.lawProfileBudget_bytes = std::size_t(lawCacheMiB * kMiB);
+    }
+    const vdbtrace::TracedScene traced = vdbtrace::buildTracedScene(scene, parts);
     run.buildSeconds = std::chrono::duration<double>(Clock::now() - built).count();
     run.trees = traced.treeCounts.size();
     run.boughs = traced.boughs.size();
@@ -472,6 +478,7 @@ BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
     run.result = vdbtrace::renderMethod(method).render(traced, settings, withProgress(shown));
     run.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     run.cpuSeconds = tool::processCpuSeconds() - cpu;
+    run.profiles = vdbtrace::lawProfileCounts(traced);
     return run;
 }
 
@@ -483,12 +490,13 @@ struct BenchSummary {
 
 BenchSummary benchRepeated(const scenes::Scene& scene, const std::string& method,
                            const vdbtrace::MethodSettings& settings, const std::string& label,
-                           int repeats)
+                           int repeats, double lawCacheMiB)
 {
     std::vector<BenchRun> runs;
     for (int i = 0; i < repeats; ++i) {
         runs.push_back(benchRun(scene, method, settings,
-                                repeats > 1 ? label + " " + std::to_string(i + 1) : label));
+                                repeats > 1 ? label + " " + std::to_string(i + 1) : label,
+                                lawCacheMiB));
     }
     std::sort(runs.begin(), runs.end(),
               [](const BenchRun& a, const BenchRun& b) { return a.cpuSeconds < b.cpuSeconds; });
@@ -501,7 +509,7 @@ BenchSummary benchRepeated(const scenes::Scene& scene, const std::string& method
 
 int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
           int geometrySamples, vdbtrace::NeedlePrimitive primitive, int repeats,
-          const fs::path& jsonFile, int width, int height)
+          const fs::path& jsonFile, int width, int height, double lawCacheMiB)
 {
     if (!jsonFile.empty()) {
         io::checkWritable(jsonFile);
@@ -515,7 +523,8 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
         scene.camera.height = height;
     }
     vdbtrace::MethodSettings settings;
-    const BenchSummary ms = benchRepeated(scene, "multiscale", settings, "multiscale", repeats);
+    const BenchSummary ms =
+        benchRepeated(scene, "multiscale", settings, "multiscale", repeats, lawCacheMiB);
     const vdbtrace::RenderResult& r = ms.median.result;
     const auto& st = r.stats;
     const double pixels = double(st.coneRays);
@@ -532,6 +541,13 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
               << "\ncone rays per second (wall) " << pixels / ms.median.wallSeconds
               << "\nshare of pixels: none " << share(0) << ", needle " << share(1) << ", cone "
               << share(2) << ", bough " << share(3) << '\n';
+    const vdbtrace::LawProfileCounts& profiles = ms.median.profiles;
+    std::cout << "law profiles: views " << profiles.views.computed << " computed, "
+              << profiles.views.dropped << " dropped; from the lights "
+              << profiles.fromLights.computed << " computed, " << profiles.fromLights.dropped
+              << " dropped; at most " << double(profiles.peakBytes) / kMiB << " MiB kept";
+    if (lawCacheMiB > 0.0) std::cout << " (--law-cache " << lawCacheMiB << " MiB)";
+    std::cout << '\n';
     nlohmann::json j;
     j["scene"] = sceneFile.string();
     j["resolution"] = {scene.camera.width, scene.camera.height};
@@ -550,12 +566,18 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
     j["multiscale"]["model"] = vdbtrace::renderMethod("multiscale").describe(scene, settings);
     j["multiscale"]["pixel_share"] = {{"none", share(0)}, {"needle", share(1)},
                                       {"cone", share(2)}, {"bough", share(3)}};
+    j["multiscale"]["law_profiles"] = {
+        {"views", {{"computed", profiles.views.computed}, {"dropped", profiles.views.dropped}}},
+        {"from_lights",
+         {{"computed", profiles.fromLights.computed}, {"dropped", profiles.fromLights.dropped}}},
+        {"peak_bytes", profiles.peakBytes}};
+    if (lawCacheMiB > 0.0) j["multiscale"]["law_cache_mib"] = lawCacheMiB;
     if (geometrySamples > 0) {
         vdbtrace::MethodSettings g;
         g.geometry.samples = geometrySamples;
         g.geometry.primitive = primitive;
         const std::string label = "geometry " + std::to_string(geometrySamples) + " spp";
-        const BenchSummary geo = benchRepeated(scene, "geometry", g, label, repeats);
+        const BenchSummary geo = benchRepeated(scene, "geometry", g, label, repeats, 0.0);
         const double ratio = ms.median.cpuSeconds / geo.median.cpuSeconds;
         std::cout << label << " render: CPU seconds " << geo.median.cpuSeconds << " ["
                   << geo.cpuMin << ", " << geo.cpuMax << "], wall seconds "
@@ -621,7 +643,7 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
 int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int steps, double factor,
                 const fs::path& dir, const ModelOverrides& model, int geometrySamples,
                 vdbtrace::NeedlePrimitive primitive, int repeats, bool plot, double maxMemoryGiB,
-                int width, int height)
+                int width, int height, double lawCacheMiB)
 {
     const vdbtrace::GrowthAxis axis = vdbtrace::growthAxis(axisName);
     // Validates the document the steps are grown from; its models describe the run.
@@ -680,7 +702,7 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
             tool::resetPeakMemory();
             const BenchSummary b = benchRepeated(
                 scene, method, settings,
-                "step " + std::to_string(k) + " " + method, repeats);
+                "step " + std::to_string(k) + " " + method, repeats, lawCacheMiB);
             const double peak = tool::peakMemoryMiBSinceReset();
             const BenchRun& r = b.median;
             cpu[method].push_back(r.cpuSeconds);
@@ -714,6 +736,7 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
     j["repeats"] = repeats;
     j["memory_per_step"] = ownPeaks;
     j["model"] = vdbtrace::renderMethod("multiscale").describe(asIs, {});
+    if (lawCacheMiB > 0.0) j["law_cache_mib"] = lawCacheMiB;
     j["rows"] = rows;
     j["exponents"] = exponents;
     vdbtrace::writeJsonAtomically(j, dir / "growth.json");
@@ -974,6 +997,12 @@ int main(int argc, char** argv)
             "odd in [1, 15]"))
         ->capture_default_str();
     benchCmd->add_option("--json", benchJson, "Also write every number as JSON");
+    double benchLawCacheMiB = 0.0;  // 0: keep every profile
+    benchCmd
+        ->add_option("--law-cache", benchLawCacheMiB,
+                     "MiB the multiscale runs' law profiles may keep, as render --law-cache "
+                     "(default: all); the stats count those computed again")
+        ->check(CLI::Range(1.0, 1e7));
     std::string benchResolution;
     addResolution(*benchCmd, benchResolution,
                   "WxH instead of the camera's (same view, vertical field kept; with --grow, "
@@ -1083,9 +1112,9 @@ int main(int argc, char** argv)
             }
             return benchGrowth(sceneFile, growAxis, growSteps, growFactor, growDir, model,
                                benchGeometrySamples, benchPrimitive, benchRepeats, !growNoPlot,
-                               maxMemoryGiB, benchWidth, benchHeight);
+                               maxMemoryGiB, benchWidth, benchHeight, benchLawCacheMiB);
         }
         return bench(sceneFile, scaling, model, benchGeometrySamples, benchPrimitive,
-                     benchRepeats, benchJson, benchWidth, benchHeight);
+                     benchRepeats, benchJson, benchWidth, benchHeight, benchLawCacheMiB);
     });
 }
