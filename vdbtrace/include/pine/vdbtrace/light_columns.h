@@ -24,8 +24,6 @@
 
 namespace pine::vdbtrace {
 
-class Bvh;
-
 class LightColumns {
 public:
     /// A primitive as seen from the light: its axis from `base` to `end`, within `radius_cm` of
@@ -49,7 +47,6 @@ public:
     void query(const Vec3& x, double radius_cm, double beyond_cm, Visit&& visit) const;
 
     std::size_t bytes() const;
-    double cell_cm() const { return mCell_cm; }
 
 private:
     LightColumns() = default;
