@@ -13,6 +13,11 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
                                                   const Vec3& towardsLight, std::size_t maxBytes)
 {
     if (count == 0 || order.size() != count) return nullptr;
+    // Each primitive takes one entry at least: too many are refused before anything is made
+    // (a landscape's 6.8 million would hold 250 MB while finding out).
+    if (count * (sizeof(Entry) + sizeof(Shadow) + sizeof(std::uint32_t)) > maxBytes) {
+        return nullptr;
+    }
     std::unique_ptr<LightColumns> out(new LightColumns);
     LightColumns& c = *out;
     c.mTowardsLight = towardsLight;
