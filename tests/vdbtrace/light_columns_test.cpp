@@ -1,9 +1,9 @@
 // A directional light's shadow cones find their occluders in columns across the light
 // (light_columns.h): every primitive within reach, in the BVH query's order, so that each
 // transmittance is the same product as through the BVH, to the bit.
+#include "pine/vdbtrace/light_columns.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/bvh.h"
-#include "pine/vdbtrace/light_columns.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/surface_shading.h"
 #include "pine/vdbtrace/traced_scene.h"
@@ -61,8 +61,8 @@ TEST(LightColumns, YieldEveryPrimitiveWithinReachOnceInTheBvhsOrder)
     for (int i = 0; i < 2000; ++i) {
         const Vec3 base(60.0 * u(rng), 60.0 * u(rng), 30.0 * u(rng) + 30.0);
         const Vec3 along = i % 10 == 0 ? L : glm::normalize(Vec3(u(rng), u(rng), u(rng)));
-        sticks.push_back({base, base + (2.0 + 6.0 * (u(rng) + 1.0)) * along,
-                          0.05 + 1.0 * (u(rng) + 1.0)});
+        sticks.push_back(
+            {base, base + (2.0 + 6.0 * (u(rng) + 1.0)) * along, 0.05 + 1.0 * (u(rng) + 1.0)});
     }
     std::vector<Aabb> boxes;
     for (const auto& s : sticks) boxes.push_back(cylinderBounds(s.base, s.end, s.radius_cm));
@@ -127,8 +127,8 @@ TEST(LightColumns, ShadowConesReadTheSameThroughColumnsAsThroughTheBvh)
     std::vector<Vec3> at;
     std::vector<ShadowSamples> samples;
     for (int i = 0; i < 400; ++i) {
-        const TracedBough& b = traced.boughs[std::size_t((u(rng) + 1.0) * 0.5 *
-                                                         double(traced.boughs.size() - 1))];
+        const TracedBough& b =
+            traced.boughs[std::size_t((u(rng) + 1.0) * 0.5 * double(traced.boughs.size() - 1))];
         at.push_back(b.base_cm + (u(rng) + 1.0) * (b.tip_cm - b.base_cm) +
                      b.radius_cm * Vec3(u(rng), u(rng), u(rng)));
         ShadowSamples s;
@@ -143,8 +143,8 @@ TEST(LightColumns, ShadowConesReadTheSameThroughColumnsAsThroughTheBvh)
         std::vector<double> T;
         for (std::size_t i = 0; i < at.size(); ++i) {
             const double footprint = 0.2 + 2.0 * (1.0 + std::sin(double(i)));
-            T.push_back(shadowConeTransmittance(s, at[i], sun, footprint, kNoPrimitive, true,
-                                                &samples[i]));
+            T.push_back(
+                shadowConeTransmittance(s, at[i], sun, footprint, kNoPrimitive, true, &samples[i]));
             T.push_back(shadowConeTransmittance(s, at[i], sun, footprint, kNoPrimitive, false));
         }
         return T;

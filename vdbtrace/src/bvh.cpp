@@ -144,7 +144,9 @@ std::vector<std::uint32_t> Bvh::queryOrder() const
         const Node& node = mNodes[stack.back()];
         stack.pop_back();
         if (node.count > 0) {
-            for (std::uint32_t i = 0; i < node.count; ++i) order.push_back(mIndices[node.first + i]);
+            for (std::uint32_t i = 0; i < node.count; ++i) {
+                order.push_back(mIndices[node.first + i]);
+            }
         } else {
             stack.push_back(node.first);
             stack.push_back(node.first + 1);

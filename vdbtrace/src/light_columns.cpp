@@ -27,8 +27,8 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
     c.mIndexOf.resize(count);
     std::vector<float> depths(count);
     std::vector<double> radii(count);
-    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-    double hi[2] = {-lo[0], -lo[1]};
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    double lo[2] = {kInf, kInf}, hi[2] = {-kInf, -kInf};
     for (std::size_t rank = 0; rank < count; ++rank) {
         const std::uint32_t index = order[rank];
         const Primitive p = at(index);

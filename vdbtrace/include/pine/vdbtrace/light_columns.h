@@ -76,7 +76,7 @@ private:
     int mCells[2] = {0, 0};
     std::vector<std::uint32_t> mFirst;  ///< per cell, its entries' start; one more at the end
     std::vector<Entry> mEntries;
-    std::vector<Shadow> mShadows;        ///< per rank
+    std::vector<Shadow> mShadows;         ///< per rank
     std::vector<std::uint32_t> mIndexOf;  ///< per rank, the primitive
 };
 
