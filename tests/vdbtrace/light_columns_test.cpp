@@ -2,6 +2,7 @@
 // (light_columns.h): every primitive within reach, in the BVH query's order, so that each
 // transmittance is the same product as through the BVH, to the bit.
 #include "pine/vdbtrace/light_columns.h"
+#include "pine/analytic/direction.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/bvh.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
@@ -110,6 +111,38 @@ TEST(LightColumns, YieldEveryPrimitiveWithinReachOnceInTheBvhsOrder)
         sticks.size(), [&](std::size_t i) { return sticks[i]; }, order, L, 1000));
 }
 
+TEST(LightColumns, KeepAPrimitiveAtTheEdgeOfReachWhereverItLies)
+{
+    // Long sticks far from the origin across the light, each exactly `radius` plus its own
+    // radius from the line through the origin: the floats their ends are kept in round by
+    // more than the origin's own coordinates would allow for.
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const Vec3 L = glm::normalize(Vec3(-0.5, -0.6, 0.8));
+    const Vec3 e1 = analytic::anyPerpendicular(L), e2 = glm::cross(L, e1);
+    int missed = 0;
+    for (int n = 0; n < 5000; ++n) {
+        const double half = 40.0 + 80.0 * u(rng), r = 0.05 + 2.0 * u(rng);
+        const double radius = 0.1 + 5.0 * u(rng);
+        // Oblique across the light, so that both of each end's coordinates are large.
+        const double theta = 0.2 + 1.2 * u(rng);
+        const Vec3 along = std::cos(theta) * e1 + std::sin(theta) * e2;
+        const Vec3 normal = -std::sin(theta) * e1 + std::cos(theta) * e2;
+        const Vec3 centre = (r + radius) * normal + 30.0 * (u(rng) - 0.5) * L;
+        const LightColumns::Primitive stick{centre - half * along, centre + half * along, r};
+        const auto columns = LightColumns::build(
+            1, [&](std::size_t) { return stick; }, {0u}, L, std::size_t(1) << 20);
+        ASSERT_TRUE(columns);
+        int found = 0;
+        columns->query(Vec3(0.0), radius, 100.0, [&](std::uint32_t) {
+            ++found;
+            return true;
+        });
+        missed += found == 0;
+    }
+    EXPECT_EQ(missed, 0);
+}
+
 TEST(LightColumns, ShadowConesReadTheSameThroughColumnsAsThroughTheBvh)
 {
     const scenes::Scene scene = scenes::parseScene(
@@ -158,6 +191,11 @@ TEST(LightColumns, ShadowConesReadTheSameThroughColumnsAsThroughTheBvh)
     EXPECT_LT(*std::min_element(walked.begin(), walked.end()), 0.5);  // some are shaded
     const RenderResult b = renderMultiscale(traced, {});
     EXPECT_EQ(a.image.rgba, b.image.rgba);
+    // Primitives changed after indexing: no columns of the old ones are read.
+    indexPrimitives(traced);
+    ASSERT_NE(traced.columns(sun), nullptr);
+    traced.boughs.pop_back();
+    EXPECT_EQ(traced.columns(sun), nullptr);
     EXPECT_EQ(a.image.aovs, b.image.aovs);
     EXPECT_EQ(a.stats.shadowRays, b.stats.shadowRays);
 }

@@ -40,7 +40,10 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
             lo[k] = std::min(lo[k], std::min(a, b) - p.radius_cm);
             hi[k] = std::max(hi[k], std::max(a, b) + p.radius_cm);
         }
-        s.radius = roundedUp(p.radius_cm);
+        // The floats' rounding of a and b (6e-8 of each) in the radius, so that a query's
+        // distance from them errs on the near side.
+        s.radius = roundedUp(p.radius_cm + 1e-6 * (std::abs(s.a[0]) + std::abs(s.a[1]) +
+                                                   std::abs(s.b[0]) + std::abs(s.b[1]) + 1.0));
         depths[rank] = roundedDown(std::min(c.depth(p.base), c.depth(p.end)) - p.radius_cm);
         radii[rank] = p.radius_cm;
         c.mIndexOf[rank] = index;
@@ -62,15 +65,29 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
         c.mCells[k] = int(cellsAlong(k));
     }
 
-    // Each primitive goes into every cell its projected axis, grown by its radius, may cross
-    // (its box across the light).
+    // Each primitive goes into every cell its projected axis, grown by its radius (which holds
+    // the floats' rounding), may cross: its box across the light. Its first cell along each
+    // direction is kept, so that a query reads it once without computing them again.
+    for (Shadow& s : c.mShadows) {
+        for (int k = 0; k < 2; ++k) {
+            const double a = std::min(s.a[k], s.b[k]) - double(s.radius);
+            s.first[k] = std::min(c.mCells[k] - 1,
+                                  std::max(0, int(std::floor((a - c.mOrigin[k]) / c.mCell_cm))));
+        }
+    }
+    const auto cellRange = [&](const Shadow& s, int k, int& from, int& to) {
+        const double b = std::max(s.a[k], s.b[k]) + double(s.radius);
+        from = s.first[k];
+        to = std::max(from,
+                      std::min(c.mCells[k] - 1, int(std::floor((b - c.mOrigin[k]) / c.mCell_cm))));
+    };
     const std::size_t cells = std::size_t(c.mCells[0]) * std::size_t(c.mCells[1]);
     std::vector<std::uint32_t> perCell(cells + 1, 0);
     std::size_t entries = 0;
     for (int pass = 0; pass < 2; ++pass) {
         for (std::size_t rank = 0; rank < count; ++rank) {
             int from[2], to[2];
-            for (int k = 0; k < 2; ++k) c.cellRange(c.mShadows[rank], k, from[k], to[k]);
+            for (int k = 0; k < 2; ++k) cellRange(c.mShadows[rank], k, from[k], to[k]);
             for (int j = from[1]; j <= to[1]; ++j) {
                 for (int i = from[0]; i <= to[0]; ++i) {
                     const std::size_t cell = std::size_t(j) * std::size_t(c.mCells[0]) + i;

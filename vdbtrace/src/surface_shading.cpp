@@ -78,7 +78,9 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         // Every occluder that can shade a point lies within this of x's line (its strip's
         // half-width more): a point's line at most `reach` off it, read over at most the
         // cone's width.
-        columns->query(x, 0.5 * ray.width(tMax + behind) + reach, behind, occluder);
+        // A centimetre deeper than the visitor reads: where an occluder runs nearly along the
+        // light, closestPassage places it along the cone less precisely.
+        columns->query(x, 0.5 * ray.width(tMax + behind) + reach, behind + 1.0, occluder);
     } else {
         scene.bvh.query(ray, tMax + behind, occluder);
     }

@@ -21,6 +21,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <shared_mutex>
 #include <stdexcept>
 #include <utility>
@@ -460,24 +461,36 @@ Sphere primitiveBall(const TracedScene& scene, std::size_t primitive)
 }
 
 struct LightColumnsSet {
-    explicit LightColumnsSet(std::size_t lights) : once(lights), columns(lights) {}
+    LightColumnsSet(std::size_t lights, std::size_t indexed)
+        : once(lights), columns(lights), primitives(indexed)
+    {
+    }
     std::vector<std::once_flag> once;
     std::vector<std::unique_ptr<LightColumns>> columns;
+    std::size_t primitives;  ///< what the BVH indexed when the set was made
 };
 
 const LightColumns* TracedScene::columns(std::size_t light) const
 {
-    if (!lightColumns || light >= lights.size() || !lights[light].directional) return nullptr;
+    // Primitives or lights changed since indexPrimitives: none (the BVH is stale too).
+    const std::size_t count = branches.size() + boughs.size();
+    if (!lightColumns || light >= lightColumns->once.size() || light >= lights.size() ||
+        !lights[light].directional || lightColumns->primitives != count) {
+        return nullptr;
+    }
     LightColumnsSet& set = *lightColumns;
     std::call_once(set.once[light], [&] {
-        const std::size_t count = branches.size() + boughs.size();
-        set.columns[light] = LightColumns::build(
-            count,
-            [&](std::size_t i) {
-                const PrimitiveCylinder c = primitiveCylinder(*this, i);
-                return LightColumns::Primitive{c.base, c.end, c.radius_cm};
-            },
-            bvh.queryOrder(), lights[light].towardsLight, kLightColumnsMax_bytes);
+        try {
+            set.columns[light] = LightColumns::build(
+                count,
+                [&](std::size_t i) {
+                    const PrimitiveCylinder c = primitiveCylinder(*this, i);
+                    return LightColumns::Primitive{c.base, c.end, c.radius_cm};
+                },
+                bvh.queryOrder(), lights[light].towardsLight, kLightColumnsMax_bytes);
+        } catch (const std::bad_alloc&) {
+            set.columns[light].reset();  // the cones walk the BVH, to the same result
+        }
     });
     return set.columns[light].get();
 }
@@ -502,7 +515,7 @@ void indexPrimitives(TracedScene& scene)
         box = cylinderBounds(c.base, c.end, c.radius_cm);
         ball = cylinderSphere(c.base, c.end, c.radius_cm);
     });
-    scene.lightColumns = std::make_shared<LightColumnsSet>(scene.lights.size());
+    scene.lightColumns = std::make_shared<LightColumnsSet>(scene.lights.size(), count);
 }
 
 TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts& parts)

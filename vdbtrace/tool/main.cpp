@@ -665,8 +665,13 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
             const bool instanced = primitive == vdbtrace::NeedlePrimitive::Curve;
             for (const char* method : {"multiscale", "geometry"}) {
                 if (std::string(method) == "geometry" && geometrySamples == 0) continue;
-                bake::checkMemory(bake::estimateRender(step, method, 0.0, 0.0, instanced),
-                                  bake::memoryLimit(maxMemoryGiB), method);
+                // The multiscale profiles within --law-cache, as the runs will keep them.
+                const double profiles = std::string(method) == "multiscale" && lawCacheMiB > 0.0
+                                            ? lawCacheMiB * kMiB
+                                            : std::numeric_limits<double>::infinity();
+                bake::checkMemory(
+                    bake::estimateRender(step, method, 0.0, 0.0, instanced, profiles),
+                    bake::memoryLimit(maxMemoryGiB), method);
             }
         } catch (const std::exception& e) {
             std::ostringstream where;
@@ -1113,6 +1118,10 @@ int main(int argc, char** argv)
             return benchGrowth(sceneFile, growAxis, growSteps, growFactor, growDir, model,
                                benchGeometrySamples, benchPrimitive, benchRepeats, !growNoPlot,
                                maxMemoryGiB, benchWidth, benchHeight, benchLawCacheMiB);
+        }
+        if (scaling && benchLawCacheMiB > 0.0) {
+            throw InputError("--law-cache does not apply to --scaling (it times the law's "
+                             "profiles of every bough, all kept)");
         }
         return bench(sceneFile, scaling, model, benchGeometrySamples, benchPrimitive,
                      benchRepeats, benchJson, benchWidth, benchHeight, benchLawCacheMiB);

@@ -53,22 +53,14 @@ private:
     // Where a primitive's axis projects across the light, and how far it reaches (rounded up).
     struct Shadow {
         float a[2], b[2];
-        float radius;
+        float radius;           ///< its radius, and the rounding of a and b to floats
+        std::int32_t first[2];  ///< the first cell along each of the across directions
     };
     struct Entry {
         float depth;  ///< the nearest to the light any of it lies (rounded down)
         std::uint32_t rank;
     };
     double across(const Vec3& p, int k) const { return glm::dot(p, mAcross[k]); }
-    // The cells along `k` a primitive is binned in: its projected axis grown by its radius and
-    // by the floats' rounding, as a query's reach is.
-    void cellRange(const Shadow& s, int k, int& from, int& to) const
-    {
-        const double grown = double(s.radius) + 1e-6 * (std::abs(s.a[k]) + std::abs(s.b[k]) + 1.0);
-        const double a = std::min(s.a[k], s.b[k]) - grown, b = std::max(s.a[k], s.b[k]) + grown;
-        from = std::max(0, int(std::floor((a - mOrigin[k]) / mCell_cm)));
-        to = std::min(mCells[k] - 1, int(std::floor((b - mOrigin[k]) / mCell_cm)));
-    }
     double depth(const Vec3& p) const { return -glm::dot(p, mTowardsLight); }
 
     Vec3 mTowardsLight{0.0}, mAcross[2] = {Vec3(0.0), Vec3(0.0)};
@@ -114,9 +106,8 @@ void LightColumns::query(const Vec3& x, double radius_cm, double beyond_cm, Visi
                 const double reach = double(s.radius) + radius_cm + slack;
                 if (!(ex * ex + ey * ey <= reach * reach)) continue;
                 // Once: from the first of the query's cells that the primitive is binned in.
-                int first[2], last[2];
-                for (int k = 0; k < 2; ++k) cellRange(s, k, first[k], last[k]);
-                if (std::max(first[0], from[0]) == i && std::max(first[1], from[1]) == j) {
+                if (std::max(int(s.first[0]), from[0]) == i &&
+                    std::max(int(s.first[1]), from[1]) == j) {
                     ranks.push_back(entry.rank);
                 }
             }
