@@ -173,23 +173,19 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
                                          " boughs (--law-cache MIB bounds them)",
                            bounded ? lawProfileBudget_bytes : all});
     } else if (method == "geometry") {
-        // Each variant grown once, at its first tree, while the boughs are made.
-        std::vector<std::size_t> grown;
+        // Each variant grown once, at its first tree, while the boughs are made; instanced,
+        // the first trees' needles are also the only cylinders laid out.
+        std::vector<std::size_t> firsts;
         for (std::size_t i = 0; i < scene.trees.size(); ++i) {
-            if (scene.trees[i].variantOf < 0) grown.push_back(i);
+            if (scene.trees[i].variantOf < 0) firsts.push_back(i);
         }
-        const double grownBoughs = grown.size() < scene.trees.size()
-                                       ? sumTrees(scene, grown).boughs
-                                       : trees.boughs;
-        e.parts.push_back({"grown trees", grownBoughs * kBytesPerGrownBough});
-        std::vector<std::size_t> laidOut;  // the trees whose needles are cylinders of their own
-        for (std::size_t i = 0; i < scene.trees.size(); ++i) {
-            if (!instanceVariants || scene.trees[i].variantOf < 0) laidOut.push_back(i);
-        }
-        const bool copies = laidOut.size() < scene.trees.size();
-        const TreeSample own = copies ? sumTrees(scene, laidOut) : trees;
+        const bool copies = firsts.size() < scene.trees.size();
+        const TreeSample grown = copies ? sumTrees(scene, firsts) : trees;
+        e.parts.push_back({"grown trees", grown.boughs * kBytesPerGrownBough});
+        const bool shared = copies && instanceVariants;
+        const TreeSample own = shared ? grown : trees;
         e.parts.push_back({count(own.needles) + " needle cylinders" +
-                               (copies ? " (a variant's trees share them)" : ""),
+                               (shared ? " (a variant's trees share them)" : ""),
                            own.needles * kBytesPerNeedle});
     } else if (method == "reference") {
         if (voxelsRead > 0.0) {

@@ -50,9 +50,8 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
     }
     // Cells about three times a typical primitive's radius: a bough's cones' reach, so that
     // a shadow tube as wide as a pixel's footprint reads one to four cells.
-    std::vector<double> sorted = radii;
-    std::nth_element(sorted.begin(), sorted.begin() + long(count / 2), sorted.end());
-    c.mCell_cm = std::max(3.0 * sorted[count / 2], 1e-3);
+    std::nth_element(radii.begin(), radii.begin() + long(count / 2), radii.end());
+    c.mCell_cm = std::max(3.0 * radii[count / 2], 1e-3);
     const auto cellsAlong = [&](int k) {
         return std::max(1.0, std::ceil((hi[k] - lo[k]) / c.mCell_cm));
     };

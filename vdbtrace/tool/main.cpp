@@ -214,6 +214,21 @@ constexpr double kMiB = 1024.0 * 1024.0;
 /// most would be computed again and again.
 constexpr double kLeastLawCache_bytes = 16.0 * kMiB;
 
+/// What `--law-cache MIB` keeps the law profiles within, in bytes: all of them (infinity)
+/// without it.
+double lawCacheBytes(double lawCacheMiB)
+{
+    return lawCacheMiB > 0.0 ? lawCacheMiB * kMiB : std::numeric_limits<double>::infinity();
+}
+
+/// A method's parts of the traced scene, its law profiles within `--law-cache MIB`.
+vdbtrace::TracedSceneParts partsWithin(const vdbtrace::RenderMethod& method, double lawCacheMiB)
+{
+    vdbtrace::TracedSceneParts parts = method.parts;
+    if (lawCacheMiB > 0.0) parts.lawProfileBudget_bytes = std::size_t(lawCacheMiB * kMiB);
+    return parts;
+}
+
 int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs,
            vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles,
@@ -221,8 +236,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
            double lawCacheMiB)
 {
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
-    vdbtrace::TracedSceneParts parts = method.parts;
-    if (lawCacheMiB > 0.0) parts.lawProfileBudget_bytes = std::size_t(lawCacheMiB * kMiB);
+    vdbtrace::TracedSceneParts parts = partsWithin(method, lawCacheMiB);
     // The extension decides the format: only EXR holds the render (its PNG goes beside it).
     std::string extension = out.extension().string();
     for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -282,8 +296,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                     lawProfiles_bytes);
             };
             const double limit = bake::memoryLimit(maxMemoryGiB);
-            bake::ResourceEstimate needs = estimate(
-                lawCacheMiB > 0.0 ? lawCacheMiB * kMiB : std::numeric_limits<double>::infinity());
+            bake::ResourceEstimate needs = estimate(lawCacheBytes(lawCacheMiB));
             // Without --law-cache, profiles that would not fit are kept within what is left,
             // as --law-cache would keep them: the same image, some recomputed. (Each estimate
             // grows a tree a species: the one without profiles only where it is needed.)
@@ -455,7 +468,8 @@ struct BenchRun {
     double needles = 0.0;  ///< expected count (cones times needles per cone)
 };
 
-// `lawCacheMiB` > 0 bounds a multiscale render's law profiles as `render --law-cache` does.
+// `lawCacheMiB` > 0 bounds the law profiles as `render --law-cache` does (multiscale's: the
+// other methods compute none).
 BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
                   const vdbtrace::MethodSettings& settings, const std::string& label,
                   double lawCacheMiB)
@@ -463,11 +477,8 @@ BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
     using Clock = std::chrono::steady_clock;
     BenchRun run;
     const auto built = Clock::now();
-    vdbtrace::TracedSceneParts parts = vdbtrace::renderMethod(method).parts;
-    if (method == "multiscale" && lawCacheMiB > 0.0) {
-        parts.lawProfileBudget_bytes = std::size_t(lawCacheMiB * kMiB);
-    }
-    const vdbtrace::TracedScene traced = vdbtrace::buildTracedScene(scene, parts);
+    const vdbtrace::TracedScene traced =
+        vdbtrace::buildTracedScene(scene, partsWithin(vdbtrace::renderMethod(method), lawCacheMiB));
     run.buildSeconds = std::chrono::duration<double>(Clock::now() - built).count();
     run.trees = traced.treeCounts.size();
     run.boughs = traced.boughs.size();
@@ -666,12 +677,9 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
             for (const char* method : {"multiscale", "geometry"}) {
                 if (std::string(method) == "geometry" && geometrySamples == 0) continue;
                 // The multiscale profiles within --law-cache, as the runs will keep them.
-                const double profiles = std::string(method) == "multiscale" && lawCacheMiB > 0.0
-                                            ? lawCacheMiB * kMiB
-                                            : std::numeric_limits<double>::infinity();
-                bake::checkMemory(
-                    bake::estimateRender(step, method, 0.0, 0.0, instanced, profiles),
-                    bake::memoryLimit(maxMemoryGiB), method);
+                bake::checkMemory(bake::estimateRender(step, method, 0.0, 0.0, instanced,
+                                                       lawCacheBytes(lawCacheMiB)),
+                                  bake::memoryLimit(maxMemoryGiB), method);
             }
         } catch (const std::exception& e) {
             std::ostringstream where;
