@@ -111,6 +111,72 @@ TEST(LightColumns, YieldEveryPrimitiveWithinReachOnceInTheBvhsOrder)
         sticks.size(), [&](std::size_t i) { return sticks[i]; }, order, L, 1000));
 }
 
+TEST(LightColumns, AQueryReadingTheLastOnesCandidatesYieldsWhatTheCellsWould)
+{
+    // Queries from the same point as the one before, or near it, wider or narrower, deeper or
+    // not, on two columns in turn and on columns made again: each must yield exactly what its
+    // own gather from the cells yields, in the same order.
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const Vec3 L = glm::normalize(Vec3(0.3, -0.4, 0.85));
+    std::vector<LightColumns::Primitive> sticks;
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 base(30.0 * u(rng), 30.0 * u(rng), 30.0 * u(rng));
+        sticks.push_back({base, base + 3.0 * glm::normalize(Vec3(u(rng), u(rng), u(rng))),
+                          0.3 + 0.7 * (u(rng) + 1.0)});
+    }
+    std::vector<std::uint32_t> order(sticks.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = std::uint32_t(order.size() - 1 - i);
+    const auto make = [&](const Vec3& towards) {
+        return LightColumns::build(
+            sticks.size(), [&](std::size_t i) { return sticks[i]; }, order, towards,
+            std::size_t(1) << 30);
+    };
+    std::unique_ptr<LightColumns> columns[2] = {make(L), make(glm::normalize(L + Vec3(0.3)))};
+    ASSERT_TRUE(columns[0] && columns[1]);
+    const auto yielded = [](const LightColumns& c, bool cells, const Vec3& x, double radius,
+                            double beyond) {
+        std::vector<std::uint32_t> got;
+        const auto visit = [&](std::uint32_t i) {
+            got.push_back(i);
+            return true;
+        };
+        if (cells) {
+            c.queryCells(x, radius, beyond, visit);
+        } else {
+            c.query(x, radius, beyond, visit);
+        }
+        return got;
+    };
+    std::size_t compared = 0, nonEmpty = 0;
+    Vec3 x(0.0);
+    double radius = 1.0, beyond = 1.0;
+    for (int q = 0; q < 6000; ++q) {
+        const int kind = q % 6;
+        if (kind == 0) {  // somewhere else
+            x = Vec3(30.0 * u(rng), 30.0 * u(rng), 30.0 * u(rng));
+            radius = 0.2 + 1.5 * (u(rng) + 1.0);
+            beyond = 1.0 + u(rng);
+        } else if (kind == 1) {  // the same point, deeper by up to 1.5 cm
+            x -= 0.75 * (u(rng) + 1.0) * L;
+        } else if (kind == 2) {  // the same point, narrower or wider
+            radius *= 1.0 + 0.2 * u(rng);
+        } else if (kind == 3) {  // a hair or a millimetre aside
+            x += (q % 12 < 6 ? 1e-9 : 0.1) * glm::normalize(Vec3(u(rng), u(rng), 0.0));
+        } else if (kind == 4 && q % 60 == 4) {  // made again: nothing kept of the old ones
+            columns[q % 120 < 60 ? 0 : 1] = make(q % 120 < 60 ? L : glm::normalize(L + Vec3(0.3)));
+        }
+        for (int c = 0; c < 2; ++c) {
+            const LightColumns& cols = *columns[(q + c) % 2];
+            const auto got = yielded(cols, false, x, radius, beyond);
+            ASSERT_EQ(got, yielded(cols, true, x, radius, beyond)) << "query " << q;
+            ++compared;
+            nonEmpty += !got.empty();
+        }
+    }
+    EXPECT_GT(nonEmpty, compared / 2);
+}
+
 TEST(LightColumns, KeepAPrimitiveAtTheEdgeOfReachWhereverItLies)
 {
     // Long sticks far from the origin across the light, each exactly `radius` plus its own

@@ -2,6 +2,8 @@
 
 #include "pine/analytic/direction.h"
 
+#include <array>
+#include <atomic>
 #include <limits>
 #include <numeric>
 
@@ -20,6 +22,8 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
     }
     std::unique_ptr<LightColumns> out(new LightColumns);
     LightColumns& c = *out;
+    static std::atomic<std::uint64_t> generations{0};
+    c.mGeneration = ++generations;
     c.mTowardsLight = towardsLight;
     c.mAcross[0] = analytic::anyPerpendicular(towardsLight);
     c.mAcross[1] = glm::cross(towardsLight, c.mAcross[0]);
@@ -119,6 +123,69 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
                   });
     }
     return out;
+}
+
+void LightColumns::gather(const double p[2], double reach_cm, double deepest,
+                          Neighbourhood& out) const
+{
+    out.generation = mGeneration;
+    out.at[0] = p[0];
+    out.at[1] = p[1];
+    out.reach_cm = reach_cm;
+    out.deepest = deepest;
+    out.candidates.clear();
+    int from[2], to[2];
+    for (int k = 0; k < 2; ++k) {
+        const double lo = (p[k] - reach_cm - mOrigin[k]) / mCell_cm;
+        const double hi = (p[k] + reach_cm - mOrigin[k]) / mCell_cm;
+        if (!(hi >= 0.0) || !(lo < double(mCells[k]))) return;
+        from[k] = std::max(0, int(std::floor(lo)));
+        to[k] = std::min(mCells[k] - 1, int(std::floor(hi)));
+    }
+    for (int j = from[1]; j <= to[1]; ++j) {
+        for (int i = from[0]; i <= to[0]; ++i) {
+            const std::size_t cell = std::size_t(j) * std::size_t(mCells[0]) + std::size_t(i);
+            for (std::uint32_t e = mFirst[cell]; e < mFirst[cell + 1]; ++e) {
+                const Entry& entry = mEntries[e];
+                if (double(entry.depth) > deepest) break;
+                const Shadow& s = mShadows[entry.rank];
+                const Candidate c{
+                    {s.a[0], s.a[1]}, {s.b[0], s.b[1]}, s.radius, entry.depth, entry.rank};
+                if (!within(c, p, reach_cm)) continue;
+                // Once: from the first of the query's cells that the primitive is binned in.
+                if (std::max(int(s.first[0]), from[0]) == i &&
+                    std::max(int(s.first[1]), from[1]) == j) {
+                    out.candidates.push_back(c);
+                }
+            }
+        }
+    }
+    std::sort(out.candidates.begin(), out.candidates.end(),
+              [](const Candidate& a, const Candidate& b) { return a.rank < b.rank; });
+}
+
+const LightColumns::Neighbourhood& LightColumns::around(const double p[2], double reach_cm,
+                                                        double deepest) const
+{
+    // Deeper than the query by this: 39% of the dense forest's shadow cones start at the same
+    // point as the one before (a bough within the levels' blend, render.level_blend, is shaded
+    // by both levels from its chord's middle), most of them no deeper than this past it.
+    // Neighbours a little wider would hold a few more, for more than they save (a gather over
+    // 1 cm more reads about twice the cells).
+    constexpr double kDeeper_cm = 1.0;
+    // One per light (a few), so that a scene's lights do not evict each other's.
+    thread_local std::array<Neighbourhood, 4> recent;
+    Neighbourhood& n = recent[mGeneration % recent.size()];
+    // Every primitive within reach_cm of p lies within reach_cm + |p - at| of `at` (the
+    // triangle inequality, with a hair for its rounding): n holds all that p's query yields.
+    const double hair = 1e-3 * slack(p);
+    const double off = std::hypot(p[0] - n.at[0], p[1] - n.at[1]);
+    if (n.generation == mGeneration && deepest <= n.deepest &&
+        off + reach_cm + hair <= n.reach_cm) {
+        return n;
+    }
+    gather(p, reach_cm + hair, deepest + kDeeper_cm, n);
+    return n;
 }
 
 std::size_t LightColumns::bytes() const

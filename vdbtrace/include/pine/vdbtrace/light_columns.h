@@ -43,8 +43,15 @@ public:
     /// Calls visit(index) -> bool (false stops) for every primitive whose cylinder comes within
     /// `radius_cm` of the line through x along the light and reaches no farther from the light
     /// than `beyond_cm` past x, in the order Bvh::query visits them; and perhaps some others.
+    /// A query that the last one this thread made of these columns holds (from the same point,
+    /// no wider, a little deeper at most) reads the candidates that one gathered.
     template <class Visit>
     void query(const Vec3& x, double radius_cm, double beyond_cm, Visit&& visit) const;
+
+    /// What a query yields, gathered afresh from the cells (the same primitives, the same
+    /// order): for tests.
+    template <class Visit>
+    void queryCells(const Vec3& x, double radius_cm, double beyond_cm, Visit&& visit) const;
 
     std::size_t bytes() const;
 
@@ -60,6 +67,44 @@ private:
         float depth;  ///< the nearest to the light any of it lies (rounded down)
         std::uint32_t rank;
     };
+    // A primitive within reach of a neighbourhood: its Shadow's projection and its Entry's depth,
+    // so that a query tests it as the cells would, without reading either again.
+    struct Candidate {
+        float a[2], b[2];
+        float radius;
+        float depth;
+        std::uint32_t rank;
+    };
+    // The primitives within `reach_cm` (rounding of x included) of the line through `at` and no
+    // deeper than `deepest`, by rank.
+    struct Neighbourhood {
+        std::uint64_t generation = 0;  ///< of the columns it was gathered from; 0: none
+        double at[2] = {0.0, 0.0};
+        double reach_cm = 0.0, deepest = 0.0;
+        std::vector<Candidate> candidates;
+    };
+    // Candidates around p within `reach_cm` and no deeper than `deepest`, gathered into `out`.
+    void gather(const double p[2], double reach_cm, double deepest, Neighbourhood& out) const;
+    // This thread's neighbourhood holding p's query, gathered again if it does not.
+    const Neighbourhood& around(const double p[2], double reach_cm, double deepest) const;
+    // The floats' rounding of where each primitive projects, and then some, at p.
+    static double slack(const double p[2])
+    {
+        return 1e-6 * (std::abs(p[0]) + std::abs(p[1]) + 1.0);
+    }
+    // Whether c's projected axis comes within reach_cm (c's radius added) of p.
+    static bool within(const Candidate& c, const double p[2], double reach_cm)
+    {
+        const double ax = c.a[0], ay = c.a[1];
+        const double dx = double(c.b[0]) - ax, dy = double(c.b[1]) - ay;
+        const double length2 = dx * dx + dy * dy;
+        double f = length2 > 0.0 ? ((p[0] - ax) * dx + (p[1] - ay) * dy) / length2 : 0.0;
+        f = std::clamp(f, 0.0, 1.0);
+        const double ex = ax + f * dx - p[0], ey = ay + f * dy - p[1];
+        const double reach = double(c.radius) + reach_cm;
+        return ex * ex + ey * ey <= reach * reach;
+    }
+
     double across(const Vec3& p, int k) const { return glm::dot(p, mAcross[k]); }
     double depth(const Vec3& p) const { return -glm::dot(p, mTowardsLight); }
 
@@ -70,52 +115,30 @@ private:
     std::vector<Entry> mEntries;
     std::vector<Shadow> mShadows;         ///< per rank
     std::vector<std::uint32_t> mIndexOf;  ///< per rank, the primitive
+    std::uint64_t mGeneration = 0;        ///< unique to these columns, never 0
 };
 
 template <class Visit>
 void LightColumns::query(const Vec3& x, double radius_cm, double beyond_cm, Visit&& visit) const
 {
     const double p[2] = {across(x, 0), across(x, 1)};
-    // The floats' rounding of where each primitive projects, and then some.
-    const double slack = 1e-6 * (std::abs(p[0]) + std::abs(p[1]) + 1.0);
-    int from[2], to[2];
-    for (int k = 0; k < 2; ++k) {
-        const double lo = (p[k] - radius_cm - slack - mOrigin[k]) / mCell_cm;
-        const double hi = (p[k] + radius_cm + slack - mOrigin[k]) / mCell_cm;
-        if (!(hi >= 0.0) || !(lo < double(mCells[k]))) return;
-        from[k] = std::max(0, int(std::floor(lo)));
-        to[k] = std::min(mCells[k] - 1, int(std::floor(hi)));
+    const double reach = radius_cm + slack(p), deepest = depth(x) + beyond_cm;
+    // Each candidate tested as the cells' entries are: the same primitives, in rank order.
+    for (const Candidate& c : around(p, reach, deepest).candidates) {
+        if (double(c.depth) > deepest || !within(c, p, reach)) continue;
+        if (!visit(mIndexOf[c.rank])) return;
     }
-    const double deepest = depth(x) + beyond_cm;
-    thread_local std::vector<std::uint32_t> ranks;
-    ranks.clear();
-    for (int j = from[1]; j <= to[1]; ++j) {
-        for (int i = from[0]; i <= to[0]; ++i) {
-            const std::size_t cell = std::size_t(j) * std::size_t(mCells[0]) + std::size_t(i);
-            for (std::uint32_t e = mFirst[cell]; e < mFirst[cell + 1]; ++e) {
-                const Entry& entry = mEntries[e];
-                if (double(entry.depth) > deepest) break;
-                // The distance from x's line to the primitive's projected axis, squared.
-                const Shadow& s = mShadows[entry.rank];
-                const double ax = s.a[0], ay = s.a[1];
-                const double dx = double(s.b[0]) - ax, dy = double(s.b[1]) - ay;
-                const double length2 = dx * dx + dy * dy;
-                double f = length2 > 0.0 ? ((p[0] - ax) * dx + (p[1] - ay) * dy) / length2 : 0.0;
-                f = std::clamp(f, 0.0, 1.0);
-                const double ex = ax + f * dx - p[0], ey = ay + f * dy - p[1];
-                const double reach = double(s.radius) + radius_cm + slack;
-                if (!(ex * ex + ey * ey <= reach * reach)) continue;
-                // Once: from the first of the query's cells that the primitive is binned in.
-                if (std::max(int(s.first[0]), from[0]) == i &&
-                    std::max(int(s.first[1]), from[1]) == j) {
-                    ranks.push_back(entry.rank);
-                }
-            }
-        }
-    }
-    std::sort(ranks.begin(), ranks.end());
-    for (const std::uint32_t rank : ranks) {
-        if (!visit(mIndexOf[rank])) return;
+}
+
+template <class Visit>
+void LightColumns::queryCells(const Vec3& x, double radius_cm, double beyond_cm,
+                              Visit&& visit) const
+{
+    const double p[2] = {across(x, 0), across(x, 1)};
+    Neighbourhood n;
+    gather(p, radius_cm + slack(p), depth(x) + beyond_cm, n);
+    for (const Candidate& c : n.candidates) {
+        if (!visit(mIndexOf[c.rank])) return;
     }
 }
 
