@@ -285,6 +285,18 @@ assert ("multiscale render: CPU seconds %g [%g, %g]" % (j["multiscale"]["cpu_sec
         j["multiscale"]["cpu_seconds_min"], j["multiscale"]["cpu_seconds_max"])) in out, out
 assert "geometry 2 spp render: CPU seconds %g" % j["geometry"]["cpu_seconds"] in out, out
 PY
+# Its shadow columns are the ones a render of the scene makes (three firs: a sun, shadows on).
+"$vdbtrace" render "$work/small-firs.json" --method multiscale --out "$work/small-firs.exr" \
+    --stats "$work/small-firs.stats.json" >/dev/null 2>"$work/err" \
+    || fail "render small firs: $(tail -1 "$work/err")"
+/usr/bin/python3 - "$work/bench.json" "$work/small-firs.stats.json" "$work/bench.out" <<'PY' \
+    || fail "bench's shadow columns: $(cat "$work/bench.out")"
+import json, sys
+bench, stats = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+b = bench["multiscale"]["shadow_columns_bytes"]
+assert b > 0 and b == stats["shadow_columns_bytes"], (b, stats.get("shadow_columns_bytes"))
+assert "shadow columns %g MiB" % (b / 2**20) in open(sys.argv[3]).read()
+PY
 expect_error "bench JSON into a missing folder" 2 "no/such" -- \
     bench "$work/small-firs.json" --json "$work/no/such/b.json"
 cp "$work/small-firs.json" "$work/kept.json"

@@ -463,6 +463,7 @@ std::string machineDescription();
 struct BenchRun {
     vdbtrace::RenderResult result;
     vdbtrace::LawProfileCounts profiles;  ///< multiscale: the law profiles it computed
+    std::size_t columnsBytes = 0;         ///< its lights' shadow columns (light_columns.h)
     double wallSeconds = 0.0, cpuSeconds = 0.0, buildSeconds = 0.0;
     std::size_t trees = 0, boughs = 0;
     double needles = 0.0;  ///< expected count (cones times needles per cone)
@@ -490,6 +491,7 @@ BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
     run.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     run.cpuSeconds = tool::processCpuSeconds() - cpu;
     run.profiles = vdbtrace::lawProfileCounts(traced);
+    run.columnsBytes = vdbtrace::lightColumnsBytes(traced);
     return run;
 }
 
@@ -583,6 +585,10 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
          {{"computed", profiles.fromLights.computed}, {"dropped", profiles.fromLights.dropped}}},
         {"peak_bytes", profiles.peakBytes}};
     if (lawCacheMiB > 0.0) j["multiscale"]["law_cache_mib"] = lawCacheMiB;
+    if (ms.median.columnsBytes > 0) {
+        j["multiscale"]["shadow_columns_bytes"] = ms.median.columnsBytes;
+        std::cout << "shadow columns " << double(ms.median.columnsBytes) / kMiB << " MiB\n";
+    }
     if (geometrySamples > 0) {
         vdbtrace::MethodSettings g;
         g.geometry.samples = geometrySamples;
