@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 
@@ -114,11 +115,11 @@ TEST(LightColumns, YieldEveryPrimitiveWithinReachOnceInTheBvhsOrder)
 TEST(LightColumns, AQueryReadingTheLastOnesCandidatesYieldsWhatTheCellsWould)
 {
     // Queries from the same point as the one before, or near it, wider or narrower, deeper or
-    // not, on two columns in turn and on columns made again: each must yield exactly what its
-    // own gather from the cells yields, in the same order.
+    // not, on six columns at once (more than a thread keeps neighbourhoods for), on columns
+    // made again for another light, and after queries with infinite, huge or negative
+    // values: each must yield exactly what its own gather from the cells yields, in order.
     std::mt19937 rng(23);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
-    const Vec3 L = glm::normalize(Vec3(0.3, -0.4, 0.85));
     std::vector<LightColumns::Primitive> sticks;
     for (int i = 0; i < 3000; ++i) {
         const Vec3 base(30.0 * u(rng), 30.0 * u(rng), 30.0 * u(rng));
@@ -127,13 +128,18 @@ TEST(LightColumns, AQueryReadingTheLastOnesCandidatesYieldsWhatTheCellsWould)
     }
     std::vector<std::uint32_t> order(sticks.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = std::uint32_t(order.size() - 1 - i);
-    const auto make = [&](const Vec3& towards) {
+    std::vector<Vec3> lights(6);  // of each of the columns below
+    const auto make = [&](std::size_t c) {
+        const Vec3 towards = lights[c] = glm::normalize(Vec3(0.6 * u(rng), 0.6 * u(rng), 1.0));
         return LightColumns::build(
             sticks.size(), [&](std::size_t i) { return sticks[i]; }, order, towards,
             std::size_t(1) << 30);
     };
-    std::unique_ptr<LightColumns> columns[2] = {make(L), make(glm::normalize(L + Vec3(0.3)))};
-    ASSERT_TRUE(columns[0] && columns[1]);
+    std::vector<std::unique_ptr<LightColumns>> columns;
+    for (std::size_t c = 0; c < lights.size(); ++c) {
+        columns.push_back(make(c));
+        ASSERT_TRUE(columns.back());
+    }
     const auto yielded = [](const LightColumns& c, bool cells, const Vec3& x, double radius,
                             double beyond) {
         std::vector<std::uint32_t> got;
@@ -148,26 +154,52 @@ TEST(LightColumns, AQueryReadingTheLastOnesCandidatesYieldsWhatTheCellsWould)
         }
         return got;
     };
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    const double nan = std::nan("");
+    struct Odd {
+        Vec3 x;
+        double radius, beyond;
+    };
+    const std::vector<Odd> odd = {
+        {Vec3(0.0, kInf, 0.0), 1.0, 1.0},   {Vec3(0.0, 0.0, -kInf), 1.0, 1.0},
+        {Vec3(nan, 0.0, 0.0), 1.0, 1.0},    {Vec3(1.0, 2.0, 3.0), 1e12, 1.0},
+        {Vec3(1.0, 2.0, 3.0), kInf, 1.0},   {Vec3(1.0, 2.0, 3.0), -5.0, 1.0},
+        {Vec3(1.0, 2.0, 3.0), -1e-12, 1.0}, {Vec3(1.0, 2.0, 3.0), 2.0, nan},
+        {Vec3(1.0, 2.0, 3.0), 2.0, -kInf},  {Vec3(1e7, 0.0, 0.0), 2.0, 1.0}};
     std::size_t compared = 0, nonEmpty = 0;
-    Vec3 x(0.0);
+    Vec3 x(1.0, 2.0, 3.0);
     double radius = 1.0, beyond = 1.0;
-    for (int q = 0; q < 6000; ++q) {
-        const int kind = q % 6;
+    for (int q = 0; q < 7000; ++q) {
+        const int kind = q % 7;
         if (kind == 0) {  // somewhere else
             x = Vec3(30.0 * u(rng), 30.0 * u(rng), 30.0 * u(rng));
             radius = 0.2 + 1.5 * (u(rng) + 1.0);
             beyond = 1.0 + u(rng);
-        } else if (kind == 1) {  // the same point, deeper by up to 1.5 cm
-            x -= 0.75 * (u(rng) + 1.0) * L;
+        } else if (kind == 1) {  // the same point as the first columns below see it, deeper
+            x -= 0.75 * (u(rng) + 1.0) * lights[std::size_t(q) % lights.size()];
         } else if (kind == 2) {  // the same point, narrower or wider
             radius *= 1.0 + 0.2 * u(rng);
         } else if (kind == 3) {  // a hair or a millimetre aside
-            x += (q % 12 < 6 ? 1e-9 : 0.1) * glm::normalize(Vec3(u(rng), u(rng), 0.0));
-        } else if (kind == 4 && q % 60 == 4) {  // made again: nothing kept of the old ones
-            columns[q % 120 < 60 ? 0 : 1] = make(q % 120 < 60 ? L : glm::normalize(L + Vec3(0.3)));
+            x += (q % 14 < 7 ? 1e-9 : 0.1) * glm::normalize(Vec3(u(rng), u(rng), 0.0));
+        } else if (kind == 4 && q % 70 == 4) {  // made again for another light
+            const std::size_t c = std::size_t(q / 70) % columns.size();
+            columns[c] = make(c);
+        } else if (kind == 5) {  // an odd query, then the same point as before it
+            const Odd& o = odd[std::size_t(q / 7) % odd.size()];
+            for (const auto& c : columns) {
+                const auto got = yielded(*c, false, o.x, o.radius, o.beyond);
+                ASSERT_EQ(got, yielded(*c, true, o.x, o.radius, o.beyond))
+                    << "odd query " << (q / 7) % odd.size();
+                // A reach of more cells than an int counts still reads them all.
+                if (o.radius == 1e12) {
+                    EXPECT_GT(got.size(), sticks.size() / 4);
+                }
+            }
+        } else if (kind == 6) {  // narrower, from the point before the odd query
+            radius *= 0.9;
         }
         for (int c = 0; c < 2; ++c) {
-            const LightColumns& cols = *columns[(q + c) % 2];
+            const LightColumns& cols = *columns[std::size_t(q + c) % columns.size()];
             const auto got = yielded(cols, false, x, radius, beyond);
             ASSERT_EQ(got, yielded(cols, true, x, radius, beyond)) << "query " << q;
             ++compared;

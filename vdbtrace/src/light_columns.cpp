@@ -128,19 +128,24 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
 void LightColumns::gather(const double p[2], double reach_cm, double deepest,
                           Neighbourhood& out) const
 {
-    out.generation = mGeneration;
+    out.candidates.clear();
+    // Held for later queries only where it is all finite: an infinite point or reach (whose
+    // scan reads nothing) would hold every point.
+    const bool finite = std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(reach_cm) &&
+                        std::isfinite(deepest);
+    out.generation = finite ? mGeneration : 0;
     out.at[0] = p[0];
     out.at[1] = p[1];
     out.reach_cm = reach_cm;
     out.deepest = deepest;
-    out.candidates.clear();
     int from[2], to[2];
     for (int k = 0; k < 2; ++k) {
         const double lo = (p[k] - reach_cm - mOrigin[k]) / mCell_cm;
         const double hi = (p[k] + reach_cm - mOrigin[k]) / mCell_cm;
         if (!(hi >= 0.0) || !(lo < double(mCells[k]))) return;
-        from[k] = std::max(0, int(std::floor(lo)));
-        to[k] = std::min(mCells[k] - 1, int(std::floor(hi)));
+        // Clamped before they become ints: a reach of 2^31 cells or more reads them all.
+        from[k] = int(std::max(0.0, std::floor(lo)));
+        to[k] = int(std::min(double(mCells[k] - 1), std::floor(hi)));
     }
     for (int j = from[1]; j <= to[1]; ++j) {
         for (int i = from[0]; i <= to[0]; ++i) {
@@ -178,13 +183,15 @@ const LightColumns::Neighbourhood& LightColumns::around(const double p[2], doubl
     Neighbourhood& n = recent[mGeneration % recent.size()];
     // Every primitive within reach_cm of p lies within reach_cm + |p - at| of `at` (the
     // triangle inequality, with a hair for its rounding): n holds all that p's query yields.
+    // Gathered a hair wider than asked, so that a cone from the same point reached by another
+    // sum (a few ulps away) is held too.
     const double hair = 1e-3 * slack(p);
     const double off = std::hypot(p[0] - n.at[0], p[1] - n.at[1]);
-    if (n.generation == mGeneration && deepest <= n.deepest &&
+    if (n.generation == mGeneration && reach_cm >= 0.0 && deepest <= n.deepest &&
         off + reach_cm + hair <= n.reach_cm) {
         return n;
     }
-    gather(p, reach_cm + hair, deepest + kDeeper_cm, n);
+    gather(p, reach_cm + 2.0 * hair, deepest + kDeeper_cm, n);
     return n;
 }
 

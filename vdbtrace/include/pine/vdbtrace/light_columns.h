@@ -41,8 +41,9 @@ public:
                                                const Vec3& towardsLight, std::size_t maxBytes);
 
     /// Calls visit(index) -> bool (false stops) for every primitive whose cylinder comes within
-    /// `radius_cm` of the line through x along the light and reaches no farther from the light
-    /// than `beyond_cm` past x, in the order Bvh::query visits them; and perhaps some others.
+    /// `radius_cm` (>= 0, else none) of the line through x along the light and reaches no
+    /// farther from the light than `beyond_cm` past x, in the order Bvh::query visits them; and
+    /// perhaps some others.
     /// A query that the last one this thread made of these columns holds (from the same point,
     /// no wider, a little deeper at most) reads the candidates that one gathered.
     template <class Visit>
@@ -121,6 +122,7 @@ private:
 template <class Visit>
 void LightColumns::query(const Vec3& x, double radius_cm, double beyond_cm, Visit&& visit) const
 {
+    if (!(radius_cm >= 0.0)) return;
     const double p[2] = {across(x, 0), across(x, 1)};
     const double reach = radius_cm + slack(p), deepest = depth(x) + beyond_cm;
     // Each candidate tested as the cells' entries are: the same primitives, in rank order.
@@ -134,6 +136,7 @@ template <class Visit>
 void LightColumns::queryCells(const Vec3& x, double radius_cm, double beyond_cm,
                               Visit&& visit) const
 {
+    if (!(radius_cm >= 0.0)) return;
     const double p[2] = {across(x, 0), across(x, 1)};
     Neighbourhood n;
     gather(p, radius_cm + slack(p), depth(x) + beyond_cm, n);
