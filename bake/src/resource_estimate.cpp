@@ -33,8 +33,8 @@ constexpr double kBytesPerBough = 380.0;
 constexpr double kBytesPerBoughView = 800.0, kBytesPerBoughLight = 200.0;
 constexpr double kBytesPerGrownBough = 150.0;
 // A directional light's shadow columns, per branch or bough (64 on the paper forest), made
-// only within kColumnsMaxBytes (TracedScene::kLightColumnsMax_bytes, which the tracer keeps).
-constexpr double kBytesPerColumnPrimitive = 64.0, kColumnsMaxBytes = 96.0 * 1024 * 1024;
+// only within kShadowColumnsMax_bytes.
+constexpr double kBytesPerColumnPrimitive = 64.0;
 constexpr double kBytesPerNeedle = 140.0;
 constexpr double kBytesPerVoxel = 84.0, kBytesPerVoxelLight = 8.0;
 // A bake written in metres or in a tree's frame converts a copy of every grid while writing
@@ -160,7 +160,7 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
                        trees.branches * kBytesPerBranch + trees.boughs * kBytesPerBough});
     const double columns = (trees.branches + trees.boughs) * kBytesPerColumnPrimitive;
     if ((method == "multiscale" || method == "reference") && scene.effects.shadows &&
-        !scene.directionalLights.empty() && columns <= kColumnsMaxBytes) {
+        !scene.directionalLights.empty() && columns <= double(kShadowColumnsMax_bytes)) {
         e.parts.push_back({"shadow columns", columns * double(scene.directionalLights.size())});
     }
     if (method == "multiscale") {

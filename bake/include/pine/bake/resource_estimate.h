@@ -5,11 +5,16 @@
 
 #include "pine/scenes/scene.h"
 
+#include <cstddef>
 #include <limits>
 #include <string>
 #include <vector>
 
 namespace pine::bake {
+
+/// The most a directional light's shadow columns may take (vdbtrace's light_columns.h): the
+/// tracer makes none above it (its shadow cones walk the BVH), and the estimate counts none.
+inline constexpr std::size_t kShadowColumnsMax_bytes = std::size_t(96) << 20;
 
 struct ResourceEstimate {
     struct Part {
