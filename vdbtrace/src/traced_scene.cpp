@@ -2,6 +2,7 @@
 
 #include "pine/analytic/cone_shader.h"
 #include "pine/analytic/direction.h"
+#include "pine/bake/resource_estimate.h"
 #include "pine/bake/tree_boughs.h"
 #include "pine/scenes/colours.h"
 #include "pine/support/input_error.h"
@@ -487,7 +488,7 @@ const LightColumns* TracedScene::columns(std::size_t light) const
                     const PrimitiveCylinder c = primitiveCylinder(*this, i);
                     return LightColumns::Primitive{c.base, c.end, c.radius_cm};
                 },
-                bvh.queryOrder(), lights[light].towardsLight, kLightColumnsMax_bytes);
+                bvh.queryOrder(), lights[light].towardsLight, bake::kShadowColumnsMax_bytes);
         } catch (const std::bad_alloc&) {
             set.columns[light].reset();  // the cones walk the BVH, to the same result
         }

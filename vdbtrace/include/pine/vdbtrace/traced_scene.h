@@ -7,7 +7,6 @@
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/cone_shader.h"
 #include "pine/bake/layer_field.h"
-#include "pine/bake/resource_estimate.h"
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/vdbtrace/bough_law.h"
@@ -191,10 +190,9 @@ struct TracedScene {
     std::shared_ptr<LightColumnsSet> lightColumns;
 
     /// Light `light`'s shadow cones' columns (light_columns.h), made on first use; null for a
-    /// point light, or where they would take more than kLightColumnsMax_bytes (the cones then
-    /// walk the BVH, to the same result).
+    /// point light, or where they would take more than bake::kShadowColumnsMax_bytes (the cones
+    /// then walk the BVH, to the same result).
     const LightColumns* columns(std::size_t light) const;
-    static constexpr std::size_t kLightColumnsMax_bytes = bake::kShadowColumnsMax_bytes;
 
     bool isBranch(std::size_t primitive) const { return primitive < branches.size(); }
     const TracedBough& bough(std::size_t primitive) const
