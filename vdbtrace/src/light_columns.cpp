@@ -187,7 +187,7 @@ const LightColumns::Neighbourhood& LightColumns::around(const double p[2], doubl
     // sum (a few ulps away) is held too.
     const double hair = 1e-3 * slack(p);
     const double off = std::hypot(p[0] - n.at[0], p[1] - n.at[1]);
-    if (n.generation == mGeneration && reach_cm >= 0.0 && deepest <= n.deepest &&
+    if (n.generation == mGeneration && deepest <= n.deepest &&
         off + reach_cm + hair <= n.reach_cm) {
         return n;
     }

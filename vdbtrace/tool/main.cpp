@@ -225,7 +225,7 @@ double lawCacheBytes(double lawCacheMiB)
 vdbtrace::TracedSceneParts partsWithin(const vdbtrace::RenderMethod& method, double lawCacheMiB)
 {
     vdbtrace::TracedSceneParts parts = method.parts;
-    if (lawCacheMiB > 0.0) parts.lawProfileBudget_bytes = std::size_t(lawCacheMiB * kMiB);
+    if (lawCacheMiB > 0.0) parts.lawProfileBudget_bytes = std::size_t(lawCacheBytes(lawCacheMiB));
     return parts;
 }
 
