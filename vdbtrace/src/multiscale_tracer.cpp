@@ -97,8 +97,6 @@ private:
                                                             ///< bound and index
     std::vector<std::size_t> mOrder;  ///< mFragments' indices, composited first
     static constexpr std::uint32_t kGround = std::uint32_t(-1);  ///< in mQueue
-    /// In mQueue, with a primitive's index: queued again at its entry (primitiveEntry).
-    static constexpr std::uint32_t kAtEntry = std::uint32_t(1) << 31;
     NearestFirstQueue mQueue;  ///< the primitives the ray may yet meet
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
@@ -504,10 +502,17 @@ double primitiveEntry(const ConeRay& ray, const TracedScene& scene, std::uint32_
 {
     const PrimitiveCylinder c = primitiveCylinder(scene, index);
     const Sphere ball = cylinderSphere(c.base, c.end, c.radius_cm);
-    const double far = (glm::dot(ball.centre - ray.origin, ray.direction) + ball.radius) /
-                       std::max(1e-9, 1.0 - 0.5 * ray.spread);
+    const Vec3 toCentre = ball.centre - ray.origin;
+    const double along = glm::dot(toCentre, ray.direction);
+    const double far = (along + ball.radius) / std::max(1e-9, 1.0 - 0.5 * ray.spread);
+    const double grown = c.radius_cm + 0.5 * ray.width(far);
+    // The grown cylinder lies within the ball grown as much: a line that misses that ball
+    // (by more than rounding) misses it, and most of what the BVH yields is missed so.
+    const Vec3 off = toCentre - along * ray.direction;
+    const double reach = (ball.radius + 0.5 * ray.width(far)) * (1.0 + 1e-9) + 1e-9;
+    if (glm::dot(off, off) > reach * reach) return -std::numeric_limits<double>::infinity();
     double tIn, tOut;
-    if (!intersectCylinder(ray, c.base, c.end, c.radius_cm + 0.5 * ray.width(far), tIn, tOut)) {
+    if (!intersectCylinder(ray, c.base, c.end, grown, tIn, tOut)) {
         return -std::numeric_limits<double>::infinity();
     }
     return tIn - 1e-9 * (1.0 + std::abs(tIn));  // below rounding
@@ -553,30 +558,26 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     const auto madeBy = [&](double nearest, std::uint32_t index) {
         mMadeBy.resize(mFragments.size(), {nearest, index});
     };
+    // A primitive is visited where its fragments can begin (primitiveEntry, where tighter
+    // than its ball's bound) and shaded (a bough's law's profiles, every shadow cone) only if
+    // the pixel is not opaque there: the fragments of those nearer it may hide it whole. One
+    // the cone misses (most of those the BVH's boxes yield) is not visited at all.
     mScene.bvh.nearestFirst(
         ray, tMax, mQueue,
-        [&](std::uint32_t index) { return nearestFragment(ray, mScene, index); },
-        [&](std::uint32_t index, double nearest) {
-            compositeBefore(nearest);
+        [&](std::uint32_t index) {
+            const double entry = primitiveEntry(ray, mScene, index);
+            if (entry == -std::numeric_limits<double>::infinity()) {
+                return std::numeric_limits<double>::infinity();
+            }
+            return std::max(nearestFragment(ray, mScene, index), entry);
+        },
+        [&](std::uint32_t index, double from) {
+            compositeBefore(from);
             if (composite.opaque()) return false;
             if (index == kGround) {
                 mFragments.push_back(mSurfaces.groundAt(ray, tGround, normal));
-                madeBy(nearest, index);
+                madeBy(from, index);
                 return true;
-            }
-            const bool atEntry = index & kAtEntry;
-            index &= ~kAtEntry;
-            if (!atEntry) {
-                // Queued again at where its fragments can begin, a primitive is shaded (a
-                // bough's law's profiles, every shadow cone) only if the pixel is not opaque
-                // there: the fragments of those nearer it may hide it whole.
-                const double entry = primitiveEntry(ray, mScene, index);
-                if (entry > nearest) {
-                    mQueue.add(entry, index | kAtEntry);
-                    return true;
-                }
-            } else {
-                nearest = nearestFragment(ray, mScene, index);
             }
             if (!mScene.isBranch(index)) {
                 addBough(ray, index);
@@ -584,7 +585,7 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
                 Fragment f;
                 if (mSurfaces.branch(ray, index, tMax, f)) mFragments.push_back(f);
             }
-            madeBy(nearest, index);
+            madeBy(nearestFragment(ray, mScene, index), index);
             return true;
         });
     compositeBefore(std::numeric_limits<double>::infinity());

@@ -506,7 +506,7 @@ std::size_t lightColumnsBytes(const TracedScene& scene)
 
 void indexPrimitives(TracedScene& scene)
 {
-    // The multiscale tracer flags a primitive's index with the top bit of 32 (kAtEntry).
+    // Indices are 32 bits, the last of them the multiscale tracer's ground (kGround).
     if (scene.branches.size() + scene.boughs.size() >= (std::size_t(1) << 31)) {
         throw std::length_error("more than 2^31 branches and boughs to index");
     }

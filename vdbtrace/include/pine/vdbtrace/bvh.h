@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -101,22 +102,28 @@ public:
     /// added to `queue` beforehand, in increasing order of nearest = nearestOf(index) (then of
     /// index), until visit returns false. nearestOf must bound no lower than
     /// nearestAlong(ray, ball) of the primitive's ball: then no primitive that comes later
-    /// has a smaller bound, and the order is the one sorting them all would give.
+    /// has a smaller bound, and the order is the one sorting them all would give. A primitive
+    /// whose nearestOf is +infinity (the caller knows the ray misses it) is not visited.
     template <class NearestOf, class Visit>
     void nearestFirst(const ConeRay& ray, double tMax, NearestFirstQueue& queue,
                       NearestOf&& nearestOf, Visit&& visit) const
     {
         const Slabs slabs(ray);
-        const auto pushNode = [&](std::uint32_t index) {
+        using Entry = NearestFirstQueue::Entry;
+        const auto met = [&](std::uint32_t index, Entry& out) {
             const Node& node = mNodes[index];
-            if (slabs.meets(ray, node, tMax)) {
-                queue.push({nearestAlong(ray, Sphere{node.centre(), node.ballRadius}), index,
-                            false});
-            }
+            if (!slabs.meets(ray, node, tMax)) return false;
+            out = {nearestAlong(ray, Sphere{node.centre(), node.ballRadius}), index, false};
+            return true;
         };
-        if (!mNodes.empty()) pushNode(0);
-        while (!queue.mHeap.empty()) {
-            const NearestFirstQueue::Entry e = queue.pop();
+        // The entry to visit next when it is known without the queue: the nearer child of the
+        // node just opened, where nothing queued comes before it (the order is strict: no two
+        // entries tie), saving its push and pop.
+        Entry next{};
+        bool held = !mNodes.empty() && met(0, next);
+        while (held || !queue.mHeap.empty()) {
+            const Entry e = held ? next : queue.pop();
+            held = false;
             if (e.primitive) {
                 if (!visit(e.index, e.nearest)) return;
                 continue;
@@ -125,11 +132,31 @@ public:
             if (node.count > 0) {
                 for (std::uint32_t i = 0; i < node.count; ++i) {
                     const std::uint32_t index = mIndices[node.first + i];
-                    queue.push({nearestOf(index), index, true});
+                    const double nearest = nearestOf(index);
+                    if (nearest != std::numeric_limits<double>::infinity()) {
+                        queue.push({nearest, index, true});
+                    }
                 }
-            } else {
-                pushNode(node.first);
-                pushNode(node.first + 1);
+                continue;
+            }
+            Entry children[2];
+            int n = 0;
+            n += met(node.first, children[n]) ? 1 : 0;
+            n += met(node.first + 1, children[n]) ? 1 : 0;
+            if (n == 2) {
+                if (NearestFirstQueue::later(children[0], children[1])) {
+                    std::swap(children[0], children[1]);
+                }
+                queue.push(children[1]);
+            }
+            if (n > 0) {
+                if (queue.mHeap.empty() ||
+                    NearestFirstQueue::later(queue.mHeap.front(), children[0])) {
+                    next = children[0];
+                    held = true;
+                } else {
+                    queue.push(children[0]);
+                }
             }
         }
     }
