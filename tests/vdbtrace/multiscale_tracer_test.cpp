@@ -11,12 +11,15 @@
 
 #include "test_scenes.h"
 
+#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <random>
 #include <string>
 
 namespace pine::vdbtrace {
@@ -46,6 +49,61 @@ void expectBounded(const Image& image, const std::string& what)
         ASSERT_TRUE(level == 0.0f || (level >= 1.0f && level <= 3.0f))
             << what << " level " << level;
     }
+}
+
+// The tracer never visits a primitive whose entry is -infinity. It may not: such a primitive
+// must fail the test every fragment of it passes first, the cone's axis passing the segment
+// (base to the cones' end for a bough, base to tip for a branch) with a strip coverage above
+// 0 (addBough, SurfaceShading::branch). Cones aimed about each primitive's edge, its
+// radius and half the footprint, where a bound that forgot either would show.
+TEST(MultiscaleTracer, APrimitiveWithNoEntryCouldGiveNoFragment)
+{
+    const scenes::Scene scene =
+        scenes::parseScene(firScene(R"("diffuse", "shadows")", 48, 36), "test.json");
+    const TracedScene traced = buildTracedScene(scene);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), unit(0.0, 1.0);
+    const std::size_t count = traced.branches.size() + traced.boughs.size();
+    int missed = 0, met = 0;
+    for (int k = 0; k < 40000; ++k) {
+        const auto index = std::uint32_t(unit(rng) * double(count - 1));
+        Vec3 a, b;
+        double radius;
+        if (traced.isBranch(index)) {
+            a = traced.branches[index].base_cm;
+            b = traced.branches[index].tip_cm;
+            radius = traced.branches[index].radius_cm;
+        } else {
+            const TracedBough& bough = traced.bough(index);
+            a = bough.base_cm;
+            b = bough.conesEnd();
+            radius = bough.radius_cm;
+        }
+        // Wide footprints too (spread up to 0.05 rad), from up to 200 cm away.
+        const double spread = std::pow(10.0, -4.0 + 2.7 * unit(rng));
+        const Vec3 towards = glm::normalize(Vec3(u(rng), u(rng), u(rng)));
+        const Vec3 target = a + unit(rng) * (b - a);
+        const double distance = 5.0 + 195.0 * unit(rng);
+        const Vec3 origin = target - distance * towards;
+        const Vec3 side = glm::normalize(glm::cross(towards, b - a + Vec3(1e-9, 0.0, 0.0)));
+        const double edge = radius + 0.5 * spread * distance;
+        const ConeRay ray{origin,
+                          glm::normalize(target + edge * (0.8 + 0.4 * unit(rng)) * side - origin),
+                          spread};
+        Passage p;
+        const bool gives =
+            closestPassage(ray, a, b, p) && stripCoverage(p.gap, radius, ray.width(p.t)) > 0.0;
+        const double entry = primitiveEntry(ray, traced, index);
+        if (entry == -std::numeric_limits<double>::infinity()) {
+            ++missed;
+            ASSERT_FALSE(gives) << "primitive " << index << " cone " << k;
+        } else {
+            met += gives ? 1 : 0;
+        }
+    }
+    // Both sides of the edge, many times.
+    EXPECT_GT(missed, 4000);
+    EXPECT_GT(met, 4000);
 }
 
 TEST(MultiscaleTracer, CompositingStaysBoundedAndUsesEveryLevel)

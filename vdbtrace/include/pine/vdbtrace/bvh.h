@@ -116,9 +116,10 @@ public:
             out = {nearestAlong(ray, Sphere{node.centre(), node.ballRadius}), index, false};
             return true;
         };
-        // The entry to visit next when it is known without the queue: the nearer child of the
-        // node just opened, where nothing queued comes before it (the order is strict: no two
-        // entries tie), saving its push and pop.
+        // The entry to visit next when it is known without the queue: the root first, then the
+        // nearer child of the node just opened where nothing queued comes before it (the order
+        // is strict: no two entries tie), saving its push and pop. Opening a node early only
+        // queues its children sooner: the primitives are visited in the same order.
         Entry next{};
         bool held = !mNodes.empty() && met(0, next);
         while (held || !queue.mHeap.empty()) {

@@ -26,6 +26,12 @@ struct MultiscaleOptions {
     int forceLevel = 0;
 };
 
+/// No fragment of primitive `index` (a branch, or a bough: its needles within its cones'
+/// reach of the axis, base to the cones' end) lies nearer along the cone `ray` than this;
+/// -infinity where the cone misses the cylinder holding them grown by half its footprint: the
+/// tracer never visits such a primitive, which can give no fragment.
+double primitiveEntry(const ConeRay& ray, const TracedScene& scene, std::uint32_t index);
+
 /// Renders with the closed forms: needles (level 1) as anti-aliased cylinders, cones (level 2)
 /// by eqs. (4)-(6) at each crossing of the true cones, boughs (level 3) as section 6's volume
 /// under the scene's bough law (render.bough_law), lit through cone shadow rays.
