@@ -492,7 +492,6 @@ double nearestFragment(const ConeRay& ray, const TracedScene& scene, std::uint32
     return nearestAlong(ray, primitiveBall(scene, index));
 }
 
-
 void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
 {
     // Front to back: each primitive's fragments are made (and lit, shadow cones and all) only
