@@ -483,6 +483,31 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     mFragments.push_back(rear);
 }
 
+// primitiveEntry of the primitive of cylinder `c` and ball `ball` (cylinderSphere of it).
+// Tighter than the ball's bound for a primitive seen side-on: a bough's needles lie within
+// its cones' reach R of the axis, base to the cones' end (and level 3's strip within that),
+// grown by a needle's radius; a branch's cylinder is itself; each fragment lies within half
+// the footprint of them (its width at the ball's far side, beyond any fragment).
+double entryInto(const ConeRay& ray, const PrimitiveCylinder& c, const Sphere& ball)
+{
+    const Vec3 toCentre = ball.centre - ray.origin;
+    const double along = glm::dot(toCentre, ray.direction);
+    const double far = (along + ball.radius) / std::max(1e-9, 1.0 - 0.5 * ray.spread);
+    const double grown = c.radius_cm + 0.5 * ray.width(far);
+    // The grown cylinder lies within the ball grown as much: a line that misses that ball
+    // (by more than rounding) misses it, and most of what the BVH yields is missed so. The
+    // tracer skips a primitive missed here (trace): a camera cone's positive spread grows
+    // the cylinder past its fragments' reach by far more than rounding.
+    const Vec3 off = toCentre - along * ray.direction;
+    const double reach = (ball.radius + 0.5 * ray.width(far)) * (1.0 + 1e-9) + 1e-9;
+    if (glm::dot(off, off) > reach * reach) return -std::numeric_limits<double>::infinity();
+    double tIn, tOut;
+    if (!intersectCylinder(ray, c.base, c.end, grown, tIn, tOut)) {
+        return -std::numeric_limits<double>::infinity();
+    }
+    return tIn - 1e-9 * (1.0 + std::abs(tIn));  // below rounding
+}
+
 // No fragment of a primitive lies nearer along the ray than its ball's bound: a bough's
 // fragments lie within its cones' reach R plus the needles' radius of its axis (base to the
 // cones' end), a branch's within its radius, and each of them within half the footprint of
@@ -539,11 +564,14 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     mScene.bvh.nearestFirst(
         ray, tMax, mQueue,
         [&](std::uint32_t index) {
-            const double entry = primitiveEntry(ray, mScene, index);
+            // The cylinder and its ball once for both bounds (nearestFragment's is the ball's).
+            const PrimitiveCylinder c = primitiveCylinder(mScene, index);
+            const Sphere ball = cylinderSphere(c.base, c.end, c.radius_cm);
+            const double entry = entryInto(ray, c, ball);
             if (entry == -std::numeric_limits<double>::infinity()) {
                 return std::numeric_limits<double>::infinity();
             }
-            return std::max(nearestFragment(ray, mScene, index), entry);
+            return std::max(nearestAlong(ray, ball), entry);
         },
         [&](std::uint32_t index, double from) {
             compositeBefore(from);
@@ -594,30 +622,10 @@ private:
 
 }  // namespace
 
-// Tighter than the ball's bound for a primitive seen side-on: a bough's needles lie within
-// its cones' reach R of the axis, base to the cones' end (and level 3's strip within that),
-// grown by a needle's radius; a branch's cylinder is itself; each fragment lies within half
-// the footprint of them (its width at the ball's far side, beyond any fragment).
 double primitiveEntry(const ConeRay& ray, const TracedScene& scene, std::uint32_t index)
 {
     const PrimitiveCylinder c = primitiveCylinder(scene, index);
-    const Sphere ball = cylinderSphere(c.base, c.end, c.radius_cm);
-    const Vec3 toCentre = ball.centre - ray.origin;
-    const double along = glm::dot(toCentre, ray.direction);
-    const double far = (along + ball.radius) / std::max(1e-9, 1.0 - 0.5 * ray.spread);
-    const double grown = c.radius_cm + 0.5 * ray.width(far);
-    // The grown cylinder lies within the ball grown as much: a line that misses that ball
-    // (by more than rounding) misses it, and most of what the BVH yields is missed so. The
-    // tracer skips a primitive missed here (trace): a camera cone's positive spread grows
-    // the cylinder past its fragments' reach by far more than rounding.
-    const Vec3 off = toCentre - along * ray.direction;
-    const double reach = (ball.radius + 0.5 * ray.width(far)) * (1.0 + 1e-9) + 1e-9;
-    if (glm::dot(off, off) > reach * reach) return -std::numeric_limits<double>::infinity();
-    double tIn, tOut;
-    if (!intersectCylinder(ray, c.base, c.end, grown, tIn, tOut)) {
-        return -std::numeric_limits<double>::infinity();
-    }
-    return tIn - 1e-9 * (1.0 + std::abs(tIn));  // below rounding
+    return entryInto(ray, c, cylinderSphere(c.base, c.end, c.radius_cm));
 }
 
 LevelBlend blendLevels(double footprint_cm, double coneSpacing_cm,
