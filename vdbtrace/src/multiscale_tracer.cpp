@@ -253,8 +253,8 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
                                        const TracedBough& b, double tIn, double tOut,
                                        double coverage, double xi, double w, Level level)
 {
-    const double phi = b.geometry.cone.aperture_rad;
-    const double cotPhi = 1.0 / std::tan(phi), sinPhi = std::sin(phi), cosPhi = std::cos(phi);
+    const ApertureTrig trig = apertureTrig(b.geometry.cone.aperture_rad);
+    const double cotPhi = trig.oneOverTan, sinPhi = trig.sinPhi, cosPhi = trig.cosPhi;
     mNeedleHits.clear();
     // The same needles as the explicit-needle ground truth (needle_layout.h).
     const NeedleLayout layout(b);

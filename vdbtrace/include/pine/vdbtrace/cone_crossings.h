@@ -16,7 +16,29 @@
 #include <tuple>
 #include <type_traits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace pine::vdbtrace {
+
+/// The trigonometry of a cone aperture phi, kept for the last phi this thread asked about: a
+/// scene's boughs share one or a few, and every walk through a bough's cones needs them. The
+/// cotangent two ways, as the walks have always computed it, so that each gives the same bits.
+struct ApertureTrig {
+    double phi, sinPhi, cosPhi;
+    double cosOverSin;  ///< cos(phi) / sin(phi)
+    double oneOverTan;  ///< 1 / tan(phi)
+};
+inline ApertureTrig apertureTrig(double phi)
+{
+    thread_local ApertureTrig last{std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0, 0.0, 0.0};
+    if (!(phi == last.phi)) {
+        const double s = std::sin(phi), c = std::cos(phi);
+        last = ApertureTrig{phi, s, c, c / s, 1.0 / std::tan(phi)};
+    }
+    return last;
+}
 
 /// g = h - rho cot(phi) at a point of bough b, with rho and the unit radial direction (zero
 /// on the axis).
@@ -61,7 +83,7 @@ void forEachConeCrossing(const TracedBough& b, const Vec3& o, const Vec3& d, dou
                          double tOut, Visit&& visit)
 {
     const double dh = b.geometry.coneSpacing_cm;
-    const double cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad);
+    const double cotPhi = apertureTrig(b.geometry.cone.aperture_rad).oneOverTan;
     const long jMax = long(std::floor(b.length_cm / dh));
     const double dt = dh / (4.0 * (1.0 + cotPhi));
     double t0 = tIn, g0 = coneHeight(b, cotPhi, o + t0 * d);
@@ -101,7 +123,7 @@ struct ConeBand {
 class ConeLine {
 public:
     ConeLine(const TracedBough& b, const Vec3& o, const Vec3& d)
-        : mCotPhi(1.0 / std::tan(b.geometry.cone.aperture_rad))
+        : mCotPhi(apertureTrig(b.geometry.cone.aperture_rad).oneOverTan)
     {
         const Vec3 r0 = o - b.base_cm;
         mH0 = glm::dot(r0, b.axis);
@@ -116,6 +138,10 @@ public:
         }
     }
     double along() const { return mAlong; }  ///< d . axis
+    /// rho^2 = q0 + t (2 q1 + t q2).
+    double q0() const { return mQ0; }
+    double q1() const { return mQ1; }
+    double q2() const { return mQ2; }
     double rho(double t) const { return std::sqrt(std::max(0.0, mQ0 + t * (2.0 * mQ1 + t * mQ2))); }
     /// d . (the point's offset from the axis): rho times the radial part of d.
     double radialRate(double t) const { return mQ1 + mQ2 * t; }
@@ -208,20 +234,53 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
     if (!(tOut > tIn) || !std::isfinite(tIn) || !std::isfinite(tOut)) return;
     const analytic::ConeGeometry& cone = b.geometry.cone;
     const double dh = b.geometry.coneSpacing_cm;
-    const double sinPhi = std::sin(cone.aperture_rad), cosPhi = std::cos(cone.aperture_rad);
-    const double cotPhi = cosPhi / sinPhi;
+    const ApertureTrig trig = apertureTrig(cone.aperture_rad);
+    const double sinPhi = trig.sinPhi, cosPhi = trig.cosPhi, cotPhi = trig.cosOverSin;
     const long jMax = long(std::floor(b.length_cm / dh));
     const double panel = dh / (1.0 + cotPhi);  // |dg/dt| <= 1 + cot(phi)
     const double coverageTimesRho = cone.needlesPerCone * cone.needleRadius_cm / analytic::kPi;
     const double layersPerCm = 1.0 / (dh * sinPhi);  // |grad g| / dh
     const ConeLine line(b, o, d);
     // sigma at o + t d; the needle direction a = cos(phi) axis + sin(phi) radial.
-    const auto sigma = [&](double t) {
+    [[maybe_unused]] const auto sigma = [&](double t) {
         const double rho = line.rho(t);
         const double dNeedle =
             rho > 0.0 ? cosPhi * line.along() + sinPhi * line.radialRate(t) / rho : line.along();
         const double coverage = rho > coverageTimesRho ? coverageTimesRho / rho : 1.0;
         return coverage * std::sqrt(std::max(0.0, 1.0 - dNeedle * dNeedle)) * layersPerCm;
+    };
+    // sigma at a Gauss-Legendre panel's two points at once: each lane the same operations in
+    // the same order, so the same bits (a packed square root or division costs what one does,
+    // and they are most of the bands' work).
+    const auto sigmaPair = [&](double t1, double t2, double out[2]) {
+#if defined(__SSE2__)
+        const __m128d t = _mm_set_pd(t2, t1), zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
+        const auto select = [](__m128d mask, __m128d yes, __m128d no) {
+            return _mm_or_pd(_mm_and_pd(mask, yes), _mm_andnot_pd(mask, no));
+        };
+        const __m128d q1 = _mm_set1_pd(line.q1()), q2 = _mm_set1_pd(line.q2());
+        // rho(t); std::max(0.0, x) is maxpd(x, 0): 0 for a NaN or -0 x, as it is.
+        const __m128d rho = _mm_sqrt_pd(_mm_max_pd(
+            _mm_add_pd(_mm_set1_pd(line.q0()),
+                       _mm_mul_pd(t, _mm_add_pd(_mm_set1_pd(2.0 * line.q1()), _mm_mul_pd(t, q2)))),
+            zero));
+        const __m128d rate = _mm_add_pd(q1, _mm_mul_pd(q2, t));  // radialRate(t)
+        const __m128d along = _mm_set1_pd(line.along());
+        const __m128d dNeedle = select(
+            _mm_cmpgt_pd(rho, zero),
+            _mm_add_pd(_mm_set1_pd(cosPhi * line.along()),
+                       _mm_div_pd(_mm_mul_pd(_mm_set1_pd(sinPhi), rate), rho)),
+            along);
+        const __m128d cover = _mm_set1_pd(coverageTimesRho);
+        const __m128d coverage =
+            select(_mm_cmpgt_pd(rho, cover), _mm_div_pd(cover, rho), one);
+        const __m128d across =
+            _mm_sqrt_pd(_mm_max_pd(_mm_sub_pd(one, _mm_mul_pd(dNeedle, dNeedle)), zero));
+        _mm_storeu_pd(out, _mm_mul_pd(_mm_mul_pd(coverage, across), _mm_set1_pd(layersPerCm)));
+#else
+        out[0] = sigma(t1);
+        out[1] = sigma(t2);
+#endif
     };
     // Where the line lies inside the bark: the branch's cylinder of radius barkRadius_cm
     // from the base to the tip (beyond the tip the last cones' needles are not in it).
@@ -251,10 +310,13 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
                     if (hi - (t0 + h) < 1e-9 * h) h = hi - t0;
                 }
                 const double mid = t0 + 0.5 * h, offset = 0.5 * h / std::sqrt(3.0);
-                for (const double t : {mid - offset, mid + offset}) {
-                    const double s = 0.5 * h * sigma(t);
+                const double points[2] = {mid - offset, mid + offset};
+                double sigmas[2];
+                sigmaPair(points[0], points[1], sigmas);
+                for (int k = 0; k < 2; ++k) {
+                    const double s = 0.5 * h * sigmas[k];
                     needles += s;
-                    weightedT += s * t;
+                    weightedT += s * points[k];
                 }
                 t0 += h;
                 rho0 = rho0 < 3.0 * panel ? line.rho(t0) : rho0 - h;  // a bound below
