@@ -99,8 +99,14 @@ private:
         const double ax = c.a[0], ay = c.a[1];
         const double dx = double(c.b[0]) - ax, dy = double(c.b[1]) - ay;
         const double length2 = dx * dx + dy * dy;
-        double f = length2 > 0.0 ? ((p[0] - ax) * dx + (p[1] - ay) * dy) / length2 : 0.0;
-        f = std::clamp(f, 0.0, 1.0);
+        // Where along the axis p comes nearest, clamped to its ends. Most candidates lie
+        // beyond an end; there the quotient would clamp to 0 or 1 anyway (division rounds
+        // monotonically), so it is only taken between them.
+        const double projected = (p[0] - ax) * dx + (p[1] - ay) * dy;
+        double f = 0.0;
+        if (length2 > 0.0 && !(projected <= 0.0)) {  // a NaN divides, as it did
+            f = projected >= length2 ? 1.0 : std::min(projected / length2, 1.0);
+        }
         const double ex = ax + f * dx - p[0], ey = ay + f * dy - p[1];
         const double reach = double(c.radius) + reach_cm;
         return ex * ex + ey * ey <= reach * reach;
