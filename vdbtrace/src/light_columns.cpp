@@ -158,14 +158,15 @@ void LightColumns::gather(const double p[2], double reach_cm, double deepest,
                 const Entry& entry = mEntries[e];
                 if (double(entry.depth) > deepest) break;
                 const Shadow& s = mShadows[entry.rank];
+                // Once: from the first of the query's cells that the primitive is binned in
+                // (tested first: it is cheaper, and a primitive lies in several cells).
+                if (std::max(int(s.first[0]), from[0]) != i ||
+                    std::max(int(s.first[1]), from[1]) != j) {
+                    continue;
+                }
                 const Candidate c{
                     {s.a[0], s.a[1]}, {s.b[0], s.b[1]}, s.radius, entry.depth, entry.rank};
-                if (!within(c, p, reach_cm)) continue;
-                // Once: from the first of the query's cells that the primitive is binned in.
-                if (std::max(int(s.first[0]), from[0]) == i &&
-                    std::max(int(s.first[1]), from[1]) == j) {
-                    out.candidates.push_back(c);
-                }
+                if (within(c, p, reach_cm)) out.candidates.push_back(c);
             }
         }
     }
