@@ -32,8 +32,9 @@ constexpr double kBytesPerBranch = 110.0;
 constexpr double kBytesPerBough = 380.0;
 constexpr double kBytesPerBoughView = 800.0, kBytesPerBoughLight = 200.0;
 constexpr double kBytesPerGrownBough = 150.0;
-// A directional light's shadow columns, per branch or bough (64 on the paper forest), made
-// only within kShadowColumnsMax_bytes.
+// A directional light's shadow columns, per branch or bough (64 on the paper forest, 59 since
+// their entries say which cell is a primitive's first; the bound kept), made only within
+// kShadowColumnsMax_bytes.
 constexpr double kBytesPerColumnPrimitive = 64.0;
 constexpr double kBytesPerNeedle = 140.0;
 constexpr double kBytesPerVoxel = 84.0, kBytesPerVoxelLight = 8.0;

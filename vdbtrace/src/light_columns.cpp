@@ -14,7 +14,8 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
                                                   const std::vector<std::uint32_t>& order,
                                                   const Vec3& towardsLight, std::size_t maxBytes)
 {
-    if (count == 0 || order.size() != count) return nullptr;
+    constexpr std::uint32_t kRankMask = (1u << 30) - 1;  // an Entry's rank's bits
+    if (count == 0 || order.size() != count || count > kRankMask) return nullptr;
     // Each primitive takes one entry at least: too many are refused before anything is made
     // (a landscape's 6.8 million would hold 250 MB while finding out).
     if (count * (sizeof(Entry) + sizeof(Shadow) + sizeof(std::uint32_t)) > maxBytes) {
@@ -73,18 +74,13 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
     }
 
     // Each primitive goes into every cell its projected axis, grown by its radius (which holds
-    // the floats' rounding), may cross: its box across the light. Its first cell along each
-    // direction is kept, so that a query reads it once without computing them again.
-    for (Shadow& s : c.mShadows) {
-        for (int k = 0; k < 2; ++k) {
-            const double a = std::min(s.a[k], s.b[k]) - double(s.radius);
-            s.first[k] = std::min(c.mCells[k] - 1,
-                                  std::max(0, int(std::floor((a - c.mOrigin[k]) / c.mCell_cm))));
-        }
-    }
+    // the floats' rounding), may cross: its box across the light. Each entry says whether its
+    // cell is the primitive's first along each direction, so that a query reads it once.
     const auto cellRange = [&](const Shadow& s, int k, int& from, int& to) {
+        const double a = std::min(s.a[k], s.b[k]) - double(s.radius);
         const double b = std::max(s.a[k], s.b[k]) + double(s.radius);
-        from = s.first[k];
+        from = std::min(c.mCells[k] - 1,
+                        std::max(0, int(std::floor((a - c.mOrigin[k]) / c.mCell_cm))));
         to = std::max(from,
                       std::min(c.mCells[k] - 1, int(std::floor((b - c.mOrigin[k]) / c.mCell_cm))));
     };
@@ -103,7 +99,8 @@ std::unique_ptr<LightColumns> LightColumns::build(std::size_t count,
                         ++entries;
                     } else {
                         c.mEntries[c.mFirst[cell] + perCell[cell]++] =
-                            Entry{depths[rank], std::uint32_t(rank)};
+                            Entry{depths[rank], std::uint32_t(rank) & kRankMask, i == from[0],
+                                  j == from[1]};
                     }
                 }
             }
@@ -157,13 +154,13 @@ void LightColumns::gather(const double p[2], double reach_cm, double deepest,
             for (std::uint32_t e = mFirst[cell]; e < mFirst[cell + 1]; ++e) {
                 const Entry& entry = mEntries[e];
                 if (double(entry.depth) > deepest) break;
-                const Shadow& s = mShadows[entry.rank];
-                // Once: from the first of the query's cells that the primitive is binned in
-                // (tested first: it is cheaper, and a primitive lies in several cells).
-                if (std::max(int(s.first[0]), from[0]) != i ||
-                    std::max(int(s.first[1]), from[1]) != j) {
+                // Once: from the first of the query's cells that the primitive is binned in,
+                // along each direction its own first or the query's first, whichever is
+                // later (tested first: a primitive lies in several cells).
+                if (!(entry.firstAlong0 || i == from[0]) || !(entry.firstAlong1 || j == from[1])) {
                     continue;
                 }
+                const Shadow& s = mShadows[entry.rank];
                 const Candidate c{
                     {s.a[0], s.a[1]}, {s.b[0], s.b[1]}, s.radius, entry.depth, entry.rank};
                 if (within(c, p, reach_cm)) out.candidates.push_back(c);

@@ -61,12 +61,16 @@ private:
     // Where a primitive's axis projects across the light, and how far it reaches (rounded up).
     struct Shadow {
         float a[2], b[2];
-        float radius;           ///< its radius, and the rounding of a and b to floats
-        std::int32_t first[2];  ///< the first cell along each of the across directions
+        float radius;  ///< its radius, and the rounding of a and b to floats
     };
     struct Entry {
         float depth;  ///< the nearest to the light any of it lies (rounded down)
-        std::uint32_t rank;
+        std::uint32_t rank : 30;
+        /// Whether this cell is the primitive's first along each across direction: a query
+        /// gathers a primitive from the first of its own cells that it reads, and this says
+        /// which that is without reading the primitive's Shadow (most entries a query scans
+        /// are primitives it meets again in another cell).
+        std::uint32_t firstAlong0 : 1, firstAlong1 : 1;
     };
     // A primitive within reach of a neighbourhood: its Shadow's projection and its Entry's depth,
     // so that a query tests it as the cells would, without reading either again.
