@@ -13,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -259,6 +261,29 @@ TEST(ConeBands, GRisesToItsTurnAndFallsAfter)
         }
     }
     EXPECT_GT(turned, 100);
+}
+
+TEST(ConeBands, AnAperturesTrigonometryIsWhatEachWalkComputedItself)
+{
+    // apertureTrig keeps the last aperture's values for every walk; the images are only the
+    // same as before if each is the very value the walks computed themselves. Apertures in
+    // turn and repeated, and the signed zeros, whose tangents differ though they compare equal.
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<double> aperture(1e-6, 1.5);
+    std::vector<double> phis = {0.0, -0.0, 0.0, 0.392699, 0.392699, -0.0};
+    for (int i = 0; i < 200; ++i) phis.push_back(i % 3 == 0 ? phis.back() : aperture(rng));
+    for (const double phi : phis) {
+        const ApertureTrig trig = apertureTrig(phi);
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(trig.sinPhi),
+                  std::bit_cast<std::uint64_t>(std::sin(phi)));
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(trig.cosPhi),
+                  std::bit_cast<std::uint64_t>(std::cos(phi)));
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(trig.cosOverSin),
+                  std::bit_cast<std::uint64_t>(std::cos(phi) / std::sin(phi)));
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(trig.oneOverTan),
+                  std::bit_cast<std::uint64_t>(1.0 / std::tan(phi)))
+            << "phi " << phi;
+    }
 }
 
 }  // namespace

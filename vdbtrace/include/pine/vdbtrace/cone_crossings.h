@@ -11,12 +11,17 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <tuple>
 #include <type_traits>
 
-#if defined(__SSE2__)
+// Packed only where scalar doubles are SSE2's too and nothing fuses a multiply and an add
+// (x87's excess precision, or -mfma's contractions of the scalar form, would differ).
+#if defined(__SSE2_MATH__) && !defined(__FMA__)
+#define PINE_CONE_BANDS_SSE2 1
 #include <emmintrin.h>
 #endif
 
@@ -33,7 +38,8 @@ struct ApertureTrig {
 inline ApertureTrig apertureTrig(double phi)
 {
     thread_local ApertureTrig last{std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0, 0.0, 0.0};
-    if (!(phi == last.phi)) {
+    // The same bits, not the same value: -0 and +0 are equal but their tangents are not.
+    if (std::bit_cast<std::uint64_t>(phi) != std::bit_cast<std::uint64_t>(last.phi)) {
         const double s = std::sin(phi), c = std::cos(phi);
         last = ApertureTrig{phi, s, c, c / s, 1.0 / std::tan(phi)};
     }
@@ -253,7 +259,7 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
     // the same order, so the same bits (a packed square root or division costs what one does,
     // and they are most of the bands' work).
     const auto sigmaPair = [&](double t1, double t2, double out[2]) {
-#if defined(__SSE2__)
+#if defined(PINE_CONE_BANDS_SSE2)
         const __m128d t = _mm_set_pd(t2, t1), zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
         const auto select = [](__m128d mask, __m128d yes, __m128d no) {
             return _mm_or_pd(_mm_and_pd(mask, yes), _mm_andnot_pd(mask, no));

@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -34,7 +35,7 @@ public:
     };
     /// Over `count` primitives, primitive(i) giving each (asked once), in `order`: rank i of
     /// Bvh::queryOrder, for light direction `towardsLight` (unit). Returns nothing if the
-    /// columns would take more than `maxBytes`.
+    /// columns would take more than `maxBytes`, or for 2^30 primitives or more.
     static std::unique_ptr<LightColumns> build(std::size_t count,
                                                const std::function<Primitive(std::size_t)>& at,
                                                const std::vector<std::uint32_t>& order,
@@ -104,12 +105,20 @@ private:
         const double dx = double(c.b[0]) - ax, dy = double(c.b[1]) - ay;
         const double length2 = dx * dx + dy * dy;
         // Where along the axis p comes nearest, clamped to its ends. Most candidates lie
-        // beyond an end; there the quotient would clamp to 0 or 1 anyway (division rounds
-        // monotonically), so it is only taken between them.
+        // beyond an end, where the quotient clamps to 0 or 1 anyway (division rounds
+        // monotonically), so it is taken only between them; an infinite length (a float
+        // overflowed) or a NaN divides, as it did.
         const double projected = (p[0] - ax) * dx + (p[1] - ay) * dy;
         double f = 0.0;
-        if (length2 > 0.0 && !(projected <= 0.0)) {  // a NaN divides, as it did
-            f = projected >= length2 ? 1.0 : std::min(projected / length2, 1.0);
+        if (length2 > 0.0) {
+            const bool finite = length2 < std::numeric_limits<double>::infinity();
+            if (finite && projected <= 0.0) {
+                f = 0.0;
+            } else if (finite && projected >= length2) {
+                f = 1.0;
+            } else {
+                f = std::clamp(projected / length2, 0.0, 1.0);
+            }
         }
         const double ex = ax + f * dx - p[0], ey = ay + f * dy - p[1];
         const double reach = double(c.radius) + reach_cm;
