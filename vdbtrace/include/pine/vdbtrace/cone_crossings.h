@@ -232,8 +232,9 @@ private:
 /// apart at the steepest, finer near the axis (tested against a fine march). Inside the bark
 /// (insideBark) the needles' roots are hidden: nothing is counted within it, unless
 /// !hiddenInBark (level 1 looks for whole needles, whose roots the branch's own fragment
-/// hides).
-template <class Visit>
+/// hides). `Packed` false evaluates each Gauss-Legendre point alone, as targets without SSE2
+/// do: the same bits, which the tests check.
+template <bool Packed = true, class Visit>
 void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn, double tOut,
                      Visit&& visit, bool hiddenInBark = true)
 {
@@ -260,6 +261,11 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
     // and they are most of the bands' work).
     const auto sigmaPair = [&](double t1, double t2, double out[2]) {
 #if defined(PINE_CONE_BANDS_SSE2)
+        if constexpr (!Packed) {
+            out[0] = sigma(t1);
+            out[1] = sigma(t2);
+            return;
+        }
         const __m128d t = _mm_set_pd(t2, t1), zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
         const auto select = [](__m128d mask, __m128d yes, __m128d no) {
             return _mm_or_pd(_mm_and_pd(mask, yes), _mm_andnot_pd(mask, no));
