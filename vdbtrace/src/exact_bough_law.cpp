@@ -112,8 +112,8 @@ public:
                        const BoughLawNeeds& needs) const override
     {
         BoughShading out;
-        const double phi = b.geometry.cone.aperture_rad;
-        const double cotPhi = 1.0 / std::tan(phi), sinPhi = std::sin(phi), cosPhi = std::cos(phi);
+        const ApertureTrig trig = apertureTrig(b.geometry.cone.aperture_rad);
+        const double cotPhi = trig.oneOverTan, sinPhi = trig.sinPhi, cosPhi = trig.cosPhi;
         const std::size_t lights = towardsLights.size();
         // Per half (0 front, 1 rear) and cell: the opacity; per light, what is lit (the
         // transfer) and what it reflects.
@@ -209,7 +209,7 @@ public:
     std::vector<double> seenByAzimuth(const TracedBough& b, const Vec3& V,
                                       const LayerModel& layers, int bins) const
     {
-        const double cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad);
+        const double cotPhi = apertureTrig(b.geometry.cone.aperture_rad).oneOverTan;
         const Vec3 ev = glm::cross(b.across, b.axis);
         std::vector<double> seen(2 * kCells * std::size_t(bins), 0.0);
         const auto at = [&](int half, int cell, int bin) -> double& {

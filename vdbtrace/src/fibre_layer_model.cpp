@@ -124,7 +124,7 @@ private:
                           double period, std::vector<Arc>& out)
     {
         out.clear();
-        const double cotPhi = 1.0 / std::tan(b.geometry.cone.aperture_rad);
+        const double cotPhi = apertureTrig(b.geometry.cone.aperture_rad).oneOverTan;
         const Vec3 e1 = analytic::anyPerpendicular(b.axis), e2 = glm::cross(b.axis, e1);
         forEachBandFrom(b, x, d, ownCone, [&](const ConeBand& band) {
             if (!(band.needles > 0.0)) return true;

@@ -249,7 +249,7 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
     const double layersPerCm = 1.0 / (dh * sinPhi);  // |grad g| / dh
     const ConeLine line(b, o, d);
     // sigma at o + t d; the needle direction a = cos(phi) axis + sin(phi) radial.
-    [[maybe_unused]] const auto sigma = [&](double t) {
+    const auto sigma = [&](double t) {
         const double rho = line.rho(t);
         const double dNeedle =
             rho > 0.0 ? cosPhi * line.along() + sinPhi * line.radialRate(t) / rho : line.along();
@@ -261,38 +261,35 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
     // and they are most of the bands' work).
     const auto sigmaPair = [&](double t1, double t2, double out[2]) {
 #if defined(PINE_CONE_BANDS_SSE2)
-        if constexpr (!Packed) {
-            out[0] = sigma(t1);
-            out[1] = sigma(t2);
+        if constexpr (Packed) {
+            const __m128d t = _mm_set_pd(t2, t1), zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
+            const auto select = [](__m128d mask, __m128d yes, __m128d no) {
+                return _mm_or_pd(_mm_and_pd(mask, yes), _mm_andnot_pd(mask, no));
+            };
+            const __m128d q1 = _mm_set1_pd(line.q1()), q2 = _mm_set1_pd(line.q2());
+            // rho(t); std::max(0.0, x) is maxpd(x, 0): 0 for a NaN or -0 x, as it is.
+            const __m128d rho = _mm_sqrt_pd(_mm_max_pd(
+                _mm_add_pd(
+                    _mm_set1_pd(line.q0()),
+                    _mm_mul_pd(t, _mm_add_pd(_mm_set1_pd(2.0 * line.q1()), _mm_mul_pd(t, q2)))),
+                zero));
+            const __m128d rate = _mm_add_pd(q1, _mm_mul_pd(q2, t));  // radialRate(t)
+            const __m128d along = _mm_set1_pd(line.along());
+            const __m128d dNeedle =
+                select(_mm_cmpgt_pd(rho, zero),
+                       _mm_add_pd(_mm_set1_pd(cosPhi * line.along()),
+                                  _mm_div_pd(_mm_mul_pd(_mm_set1_pd(sinPhi), rate), rho)),
+                       along);
+            const __m128d cover = _mm_set1_pd(coverageTimesRho);
+            const __m128d coverage = select(_mm_cmpgt_pd(rho, cover), _mm_div_pd(cover, rho), one);
+            const __m128d across =
+                _mm_sqrt_pd(_mm_max_pd(_mm_sub_pd(one, _mm_mul_pd(dNeedle, dNeedle)), zero));
+            _mm_storeu_pd(out, _mm_mul_pd(_mm_mul_pd(coverage, across), _mm_set1_pd(layersPerCm)));
             return;
         }
-        const __m128d t = _mm_set_pd(t2, t1), zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
-        const auto select = [](__m128d mask, __m128d yes, __m128d no) {
-            return _mm_or_pd(_mm_and_pd(mask, yes), _mm_andnot_pd(mask, no));
-        };
-        const __m128d q1 = _mm_set1_pd(line.q1()), q2 = _mm_set1_pd(line.q2());
-        // rho(t); std::max(0.0, x) is maxpd(x, 0): 0 for a NaN or -0 x, as it is.
-        const __m128d rho = _mm_sqrt_pd(_mm_max_pd(
-            _mm_add_pd(_mm_set1_pd(line.q0()),
-                       _mm_mul_pd(t, _mm_add_pd(_mm_set1_pd(2.0 * line.q1()), _mm_mul_pd(t, q2)))),
-            zero));
-        const __m128d rate = _mm_add_pd(q1, _mm_mul_pd(q2, t));  // radialRate(t)
-        const __m128d along = _mm_set1_pd(line.along());
-        const __m128d dNeedle = select(
-            _mm_cmpgt_pd(rho, zero),
-            _mm_add_pd(_mm_set1_pd(cosPhi * line.along()),
-                       _mm_div_pd(_mm_mul_pd(_mm_set1_pd(sinPhi), rate), rho)),
-            along);
-        const __m128d cover = _mm_set1_pd(coverageTimesRho);
-        const __m128d coverage =
-            select(_mm_cmpgt_pd(rho, cover), _mm_div_pd(cover, rho), one);
-        const __m128d across =
-            _mm_sqrt_pd(_mm_max_pd(_mm_sub_pd(one, _mm_mul_pd(dNeedle, dNeedle)), zero));
-        _mm_storeu_pd(out, _mm_mul_pd(_mm_mul_pd(coverage, across), _mm_set1_pd(layersPerCm)));
-#else
+#endif
         out[0] = sigma(t1);
         out[1] = sigma(t2);
-#endif
     };
     // Where the line lies inside the bark: the branch's cylinder of radius barkRadius_cm
     // from the base to the tip (beyond the tip the last cones' needles are not in it).

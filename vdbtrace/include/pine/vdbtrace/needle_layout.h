@@ -5,6 +5,7 @@
 #pragma once
 
 #include "pine/analytic/direction.h"
+#include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/geometry.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -36,8 +37,8 @@ public:
     explicit NeedleLayout(const TracedBough& b)
         : mBase(b.base_cm), mAxis(b.axis), mE1(analytic::anyPerpendicular(b.axis)),
           mE2(glm::cross(b.axis, mE1)), mSpacing(b.geometry.coneSpacing_cm),
-          mCos(std::cos(b.geometry.cone.aperture_rad)),
-          mSin(std::sin(b.geometry.cone.aperture_rad)),
+          mCos(apertureTrig(b.geometry.cone.aperture_rad).cosPhi),
+          mSin(apertureTrig(b.geometry.cone.aperture_rad).sinPhi),
           mLength(b.geometry.cone.needleLength_cm), mRadius(b.geometry.cone.needleRadius_cm),
           mLastCone(long(std::floor(b.length_cm / b.geometry.coneSpacing_cm))),
           mNeedles(std::max(1, int(std::lround(b.geometry.cone.needlesPerCone)))), mSeed(b.seed)
