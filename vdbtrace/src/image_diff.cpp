@@ -31,14 +31,27 @@ nlohmann::json ImageErrors::toJson() const
                             {"pixels", byLevel[k].pixels},
                             {"relative_pixels", byLevel[k].relativePixels}};
     }
+    nlohmann::json scales = nlohmann::json::array();
+    for (const AtScale& a : byScale) {
+        scales.push_back({{"k", a.k}, {"rmse", a.rmse}, {"mae", a.mae}, {"blocks", a.blocks}});
+    }
     return {{"rmse", rmse},
             {"by_level", levels},
+            {"by_scale", scales},
             {"mean_relative", meanRelative},
             {"max_absolute", maxAbsolute},
             {"relative_floor", relativeFloor},
             {"pixels", pixels},
             {"relative_pixels", relativePixels},
             {"quantity", "linear luminance of premultiplied RGB"}};
+}
+
+const ImageErrors::AtScale* ImageErrors::atScale(int k) const
+{
+    for (const AtScale& a : byScale) {
+        if (a.k == k) return &a;
+    }
+    return nullptr;
 }
 
 ImageErrors compareImages(const Image& image, const Image& reference)
@@ -90,6 +103,31 @@ ImageErrors compareImages(const Image& image, const Image& reference)
         auto& l = e.byLevel[k];
         l.rmse = l.pixels ? std::sqrt(levelSq[k] / double(l.pixels)) : 0.0;
         l.meanRelative = l.relativePixels ? levelRel[k] / double(l.relativePixels) : 0.0;
+    }
+    // Luminance is linear in RGB, so a block's mean error is the error of the blocks' means.
+    std::vector<double> signedError(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        signedError[i] = luminance(&image.rgba[4 * i]) - luminance(&reference.rgba[4 * i]);
+    }
+    for (const int k : kErrorScales) {
+        const int bw = image.width / k, bh = image.height / k;
+        if (bw < 1 || bh < 1) continue;
+        double sq = 0.0, abs = 0.0;
+        for (int by = 0; by < bh; ++by) {
+            for (int bx = 0; bx < bw; ++bx) {
+                double sum = 0.0;
+                for (int y = by * k; y < (by + 1) * k; ++y) {
+                    for (int x = bx * k; x < (bx + 1) * k; ++x) {
+                        sum += signedError[std::size_t(y) * image.width + x];
+                    }
+                }
+                const double mean = sum / double(k * k);
+                sq += mean * mean;
+                abs += std::abs(mean);
+            }
+        }
+        const std::size_t blocks = std::size_t(bw) * std::size_t(bh);
+        e.byScale.push_back({k, std::sqrt(sq / double(blocks)), abs / double(blocks), blocks});
     }
     e.pixels = n;
     e.rmse = std::sqrt(sumSq / double(std::max<std::size_t>(n, 1)));

@@ -24,8 +24,24 @@ struct ImageErrors {
         std::size_t pixels = 0, relativePixels = 0;
     };
     std::vector<ByLevel> byLevel;
+    /// The luminance error after box-downsampling both images by k (the mean of each whole k x
+    /// k block; a partial block at the right or bottom edge is left out): the error a viewer
+    /// sees once a block's needle texture is averaged. Noise falls as 1 / k, a bias does not,
+    /// so per-pixel RMSE alone rewards a smooth biased method (issue: a fair comparison).
+    struct AtScale {
+        int k = 1;
+        double rmse = 0.0, mae = 0.0;  ///< over the blocks
+        std::size_t blocks = 0;
+    };
+    /// At each of kErrorScales that leaves at least one whole block, in that order.
+    std::vector<AtScale> byScale;
+    /// The entry of byScale at k, or null.
+    const AtScale* atScale(int k) const;
     nlohmann::json toJson() const;
 };
+
+/// The box-downsampling factors ImageErrors::byScale is measured at.
+inline constexpr int kErrorScales[] = {1, 2, 4, 8, 16};
 
 /// Throws ImageError if the sizes differ.
 ImageErrors compareImages(const Image& image, const Image& reference);

@@ -1,0 +1,111 @@
+// compareImages' errors at every scale (issue: a fair comparison): after box-downsampling by k
+// a pixel's noise averages away and a bias stays, which is what the scales are for.
+#include "pine/vdbtrace/image_diff.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace pine::vdbtrace {
+namespace {
+
+void fill(Image& image, int x, int y, double grey)
+{
+    for (int c = 0; c < 3; ++c) image.pixel(x, y)[c] = float(grey);
+    image.pixel(x, y)[3] = 1.0f;
+}
+
+TEST(ImageDiffScales, NoiseAveragesAwayAndABiasStays)
+{
+    // A checkerboard of +-a about the reference (noise whose every 2 x 2 block sums to 0) on
+    // top of a bias b: per pixel sqrt(a^2 + b^2), from k = 2 on b alone.
+    const double a = 0.125, b = 0.0625;
+    Image image(32, 16), reference(32, 16);
+    for (int y = 0; y < 16; ++y) {
+        for (int x = 0; x < 32; ++x) {
+            fill(reference, x, y, 0.5);
+            fill(image, x, y, 0.5 + b + ((x + y) % 2 ? a : -a));
+        }
+    }
+    const ImageErrors e = compareImages(image, reference);
+    ASSERT_EQ(e.byScale.size(), 5u);
+    EXPECT_NEAR(e.atScale(1)->rmse, std::sqrt(a * a + b * b), 1e-7);
+    EXPECT_NEAR(e.atScale(1)->rmse, e.rmse, 1e-12);
+    for (const int k : {2, 4, 8, 16}) {
+        ASSERT_NE(e.atScale(k), nullptr) << k;
+        EXPECT_NEAR(e.atScale(k)->rmse, b, 1e-7) << k;
+        EXPECT_NEAR(e.atScale(k)->mae, b, 1e-7) << k;
+        EXPECT_EQ(e.atScale(k)->blocks, std::size_t(32 / k) * std::size_t(16 / k)) << k;
+    }
+}
+
+TEST(ImageDiffScales, PartialBlocksAndScalesWithoutABlockAreLeftOut)
+{
+    // 5 x 3: at k = 2 two whole blocks (the last column and row are partial); no whole block
+    // at k = 4 or beyond. An error in the partial column counts at k = 1 only.
+    Image image(5, 3), reference(5, 3);
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 5; ++x) {
+            fill(reference, x, y, 0.25);
+            fill(image, x, y, x == 4 || y == 2 ? 0.75 : 0.25);
+        }
+    }
+    const ImageErrors e = compareImages(image, reference);
+    ASSERT_EQ(e.byScale.size(), 2u);
+    EXPECT_EQ(e.byScale[0].k, 1);
+    EXPECT_EQ(e.byScale[1].k, 2);
+    EXPECT_EQ(e.byScale[1].blocks, 2u);
+    EXPECT_GT(e.byScale[0].rmse, 0.2);
+    EXPECT_EQ(e.byScale[1].rmse, 0.0);
+    EXPECT_EQ(e.atScale(4), nullptr);
+}
+
+// An independent computation: each image's RGB box-downsampled first, luminance after.
+double downsampledRmse(const Image& a, const Image& b, int k)
+{
+    const int bw = a.width / k, bh = a.height / k;
+    double sq = 0.0;
+    for (int by = 0; by < bh; ++by) {
+        for (int bx = 0; bx < bw; ++bx) {
+            double mean[2][3] = {};
+            for (int y = by * k; y < by * k + k; ++y) {
+                for (int x = bx * k; x < bx * k + k; ++x) {
+                    for (int c = 0; c < 3; ++c) {
+                        mean[0][c] += a.pixel(x, y)[c];
+                        mean[1][c] += b.pixel(x, y)[c];
+                    }
+                }
+            }
+            const double w[3] = {0.2126, 0.7152, 0.0722};
+            double d = 0.0;
+            for (int c = 0; c < 3; ++c) d += w[c] * (mean[0][c] - mean[1][c]) / (k * k);
+            sq += d * d;
+        }
+    }
+    return std::sqrt(sq / (bw * bh));
+}
+
+TEST(ImageDiffScales, MatchesDownsamplingTheImagesFirst)
+{
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int trial = 0; trial < 20; ++trial) {
+        const int w = 1 + int(rng() % 70), h = 1 + int(rng() % 50);
+        Image a(w, h), b(w, h);
+        for (float& v : a.rgba) v = u(rng);
+        for (float& v : b.rgba) v = u(rng) * (trial % 3 ? 1.0f : 1e-3f);  // some near black
+        const ImageErrors e = compareImages(a, b);
+        std::size_t expected = 0;
+        for (const int k : kErrorScales) expected += w / k >= 1 && h / k >= 1;
+        ASSERT_EQ(e.byScale.size(), expected) << w << "x" << h;
+        for (const ImageErrors::AtScale& s : e.byScale) {
+            EXPECT_NEAR(s.rmse, downsampledRmse(a, b, s.k), 1e-9 * (1.0 + s.rmse))
+                << w << "x" << h << " k " << s.k;
+            EXPECT_LE(s.mae, s.rmse + 1e-12);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace pine::vdbtrace
