@@ -316,5 +316,38 @@ TEST(TreeFoliage, SumsRoundTripThroughAnExrHeader)
     EXPECT_THROW(treeFoliageOf(Metadata{{kTreeFoliageAttribute, 3}}, "x"), ImageError);
 }
 
+TEST(TreeFoliage, ASummaryHasTheMedianTheWorstWithItsSignAndTheTreesBeyond)
+{
+    const auto bias = [](int tree, double luminance, double coverage) {
+        TreeBias b;
+        b.truth.tree = tree;
+        b.luminanceBias = luminance;
+        b.coverageBias = coverage;
+        return b;
+    };
+    // Luminance: sorted -0.12, -0.02, 0.01, 0.05: median -0.005, worst tree 7's -0.12, two
+    // beyond 3%. Coverage: sorted -0.04, 0, 0.02, 0.08: median 0.01, worst tree 4's +0.08.
+    std::vector<TreeBias> biases = {bias(4, 0.05, 0.08), bias(7, -0.12, 0.0),
+                                    bias(9, 0.01, -0.04), bias(2, -0.02, 0.02)};
+    TreeBiasSummary s = summarizeTreeBiases(biases);
+    EXPECT_EQ(s.trees, 4u);
+    EXPECT_DOUBLE_EQ(s.luminance.median, -0.005);
+    EXPECT_DOUBLE_EQ(s.luminance.worst, -0.12);
+    EXPECT_EQ(s.luminance.worstTree, 7);
+    EXPECT_EQ(s.luminance.beyond, 2u);
+    EXPECT_DOUBLE_EQ(s.coverage.median, 0.01);
+    EXPECT_DOUBLE_EQ(s.coverage.worst, 0.08);
+    EXPECT_EQ(s.coverage.worstTree, 4);
+    EXPECT_EQ(s.coverage.beyond, 2u);
+    // An odd count: the middle one; a threshold of 10%: one tree beyond.
+    biases.pop_back();
+    s = summarizeTreeBiases(biases, 0.1);
+    EXPECT_DOUBLE_EQ(s.luminance.median, 0.01);
+    EXPECT_EQ(s.luminance.beyond, 1u);
+    s = summarizeTreeBiases({});
+    EXPECT_EQ(s.trees, 0u);
+    EXPECT_EQ(s.luminance.worstTree, -1);
+}
+
 }  // namespace
 }  // namespace pine::vdbtrace

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <deque>
@@ -180,6 +181,34 @@ std::vector<TreeBias> treeBiases(const std::vector<TreeFoliageSum>& image,
         out.push_back({a, b, a.coverage / b.coverage - 1.0,
                        b.luminance > 0.0 ? a.luminance / b.luminance - 1.0 : 0.0});
     }
+    return out;
+}
+
+TreeBiasSummary summarizeTreeBiases(const std::vector<TreeBias>& biases, double beyond)
+{
+    TreeBiasSummary out;
+    out.trees = biases.size();
+    out.beyond = beyond;
+    const auto spread = [&](double TreeBias::*bias) {
+        TreeBiasSummary::Spread s;
+        if (biases.empty()) return s;
+        std::vector<double> values;
+        for (const TreeBias& t : biases) {
+            const double v = t.*bias;
+            values.push_back(v);
+            if (s.worstTree < 0 || std::abs(v) > std::abs(s.worst)) {
+                s.worst = v;
+                s.worstTree = t.truth.tree;
+            }
+            s.beyond += std::abs(v) > beyond;
+        }
+        std::sort(values.begin(), values.end());
+        const std::size_t n = values.size();
+        s.median = n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+        return s;
+    };
+    out.luminance = spread(&TreeBias::luminanceBias);
+    out.coverage = spread(&TreeBias::coverageBias);
     return out;
 }
 

@@ -79,4 +79,20 @@ std::vector<TreeBias> treeBiases(const std::vector<TreeFoliageSum>& image,
                                  const std::vector<TreeFoliageSum>& truth,
                                  double minCoverage = 20.0);
 
+/// A method's per-tree biases in a few numbers, as the reports state them.
+struct TreeBiasSummary {
+    std::size_t trees = 0;  ///< compared (TreeBias entries)
+    /// Median and worst (the largest in magnitude, with its sign) of each bias, and the trees
+    /// whose bias exceeds `beyond` in magnitude; the worst tree's index.
+    struct Spread {
+        double median = 0.0, worst = 0.0;
+        int worstTree = -1;
+        std::size_t beyond = 0;
+    };
+    Spread luminance, coverage;
+    double beyond = 0.03;
+};
+/// Summarises `biases`; all zero for none.
+TreeBiasSummary summarizeTreeBiases(const std::vector<TreeBias>& biases, double beyond = 0.03);
+
 }  // namespace pine::vdbtrace
