@@ -3,12 +3,16 @@
 
 Usage: MPLBACKEND=Agg /usr/bin/python3 scripts/plot_compare.py DIR
 
-Reads DIR/report.csv (columns method, setting, seconds, rmse, ...) and writes
-DIR/error_vs_time.png atomically (via DIR/error_vs_time.png.tmp.png): RMSE
-against the ground truth over render seconds, log-log, one curve per method
-(geometry's samples-per-pixel sweep, the reference's voxel-size sweep, the
-multiscale points labelled L1/L2/L3/auto). The ground truth's own row (error
-0 by definition) is left out; its time is drawn as a vertical line.
+Reads DIR/report.csv (columns method, setting, seconds, rmse, rmse_k1, ...)
+and writes, each atomically (via NAME.tmp.png):
+- DIR/error_vs_time.png: RMSE against the ground truth over render CPU seconds,
+  log-log, one curve per method (geometry's samples-per-pixel sweep, the
+  reference's voxel-size sweep, the multiscale points labelled L1/L2/L3/auto).
+  The ground truth's own row (error 0 by definition) is left out; its time is
+  drawn as a vertical line.
+- DIR/error_vs_scale.png: RMSE after box-downsampling both images by k, over k,
+  one line per render, and the truth's own error against its check (dotted).
+  Noise falls as 1/k (the dashed slope), a bias stays flat.
 """
 import csv
 import os
@@ -23,6 +27,9 @@ STYLE = {
     "reference": ("tab:orange", "s", "reference (OpenVDB, eq. 7), voxel"),
     "multiscale": ("tab:green", "D", "multiscale (closed forms)"),
 }
+
+
+LINES = ["-", "--", "-.", ":"]  # a method's settings, in the order of the rows
 
 
 def fail(msg):
@@ -42,11 +49,63 @@ def load(directory):
     return rows
 
 
+def save(fig, directory, name):
+    out = os.path.join(directory, name)
+    tmp = out + ".tmp.png"
+    fig.savefig(tmp, dpi=120)
+    os.replace(tmp, out)
+
+
+def scales(rows):
+    return sorted(int(c[len("rmse_k"):]) for c in rows[0] if c.startswith("rmse_k"))
+
+
+def plot_scales(rows, directory):
+    ks = scales(rows)
+    if not ks:
+        fail("report.csv has no rmse_k columns")
+    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    shades = {}
+    for r in rows:
+        if r["method"] == "truth":
+            continue
+        points = [(k, float(r[f"rmse_k{k}"])) for k in ks if r.get(f"rmse_k{k}")]
+        points = [p for p in points if p[1] > 0]
+        if not points:
+            continue
+        xs, ys = zip(*points)
+        if r["method"] == "truth_check":
+            ax.plot(xs, ys, color="grey", linestyle=":", marker=".",
+                    label=f"the truth's own error (against {r['setting']})")
+            continue
+        colour, marker, _ = STYLE.get(r["method"], ("black", "x", r["method"]))
+        shade = shades.get(r["method"], 0)
+        shades[r["method"]] = shade + 1
+        ax.plot(xs, ys, color=colour, marker=marker, linestyle=LINES[shade % len(LINES)],
+                label=f"{r['method']} {r['setting']}")
+    top = max(float(r["rmse_k1"]) for r in rows if r.get("rmse_k1"))
+    if top > 0:
+        ax.plot(ks, [top / k for k in ks], color="black", linestyle="--", linewidth=0.8,
+                label="1 / k (noise alone)")
+    ax.set_xscale("log", base=2)
+    ax.set_yscale("log")
+    ax.set_xticks(ks)
+    ax.set_xticklabels([str(k) for k in ks])
+    ax.set_xlabel("k: both images box-downsampled by k x k pixels")
+    ax.set_ylabel("RMSE of luminance against the ground truth")
+    ax.set_title("Error at every scale: noise falls, bias stays")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    save(fig, directory, "error_vs_scale.png")
+
+
 def main():
     if len(sys.argv) != 2:
         fail("usage: plot_compare.py DIR")
     directory = sys.argv[1]
     rows = load(directory)
+    plot_scales(rows, directory)
     fig, ax = plt.subplots(figsize=(7.5, 5.0))
     for method, (colour, marker, label) in STYLE.items():
         points = [(float(r["seconds"]), float(r["rmse"]), r["setting"])
@@ -71,16 +130,13 @@ def main():
                         textcoords="offset points", ha="right", fontsize=8, color="grey")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("render seconds (wall clock, preparation included)")
+    ax.set_xlabel("render CPU seconds (all threads, preparation included)")
     ax.set_ylabel("RMSE of luminance against the ground truth")
     ax.set_title("What accuracy costs in time")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    out = os.path.join(directory, "error_vs_time.png")
-    tmp = out + ".tmp.png"
-    fig.savefig(tmp, dpi=120)
-    os.replace(tmp, out)
+    save(fig, directory, "error_vs_time.png")
 
 
 if __name__ == "__main__":

@@ -127,11 +127,4 @@ double peakMemoryMiBSinceReset()
     return peakMemoryMiB();
 }
 
-double processCpuSeconds()
-{
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 }  // namespace pine::tool

@@ -1,14 +1,19 @@
 // `vdbtrace compare` on a tiny fir with the quick settings: every method and setting has its
 // row, image and error map, errors behave (finite, zero for the truth itself, falling with the
-// samples), and the dolly's flicker is measured for the three methods.
+// samples), the report's errors at every scale and per-tree biases are what the EXRs it wrote
+// give, and the dolly's flicker is measured for the three methods.
 #include "pine/vdbtrace/compare.h"
 #include "pine/vdbtrace/flicker.h"
+#include "pine/vdbtrace/image.h"
+
+#include <nlohmann/json.hpp>
 
 #include "test_scenes.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -83,10 +88,13 @@ TEST_F(Compare, ReportHasARowPerMethodAndSetting)
     const Table rows = readCsv(dir / "out" / "report.csv");
     std::vector<std::string> names;
     for (const auto& r : rows) names.push_back(r.at("method") + "_" + r.at("setting"));
-    const std::vector<std::string> expected = {
-        "truth_16spp",    "geometry_1spp", "geometry_4spp", "reference_1cm",
-        "reference_0.5cm", "multiscale_L1", "multiscale_L2", "multiscale_L3", "multiscale_auto"};
+    std::vector<std::string> expected = {"truth_16spp",   "geometry_1spp",   "geometry_4spp",
+                                         "reference_1cm", "reference_0.5cm", "multiscale_L1",
+                                         "multiscale_L2", "multiscale_L3",   "multiscale_auto"};
+    // Last, the truth against 4 times its samples: a number, not an image.
+    expected.push_back("truth_check_64spp");
     EXPECT_EQ(names, expected);
+    expected.pop_back();
     for (const std::string& name : expected) {
         EXPECT_TRUE(fs::exists(dir / "out" / (name + ".exr"))) << name;
         EXPECT_TRUE(fs::exists(dir / "out" / (name + ".png"))) << name;
@@ -104,6 +112,7 @@ TEST_F(Compare, ErrorsAreFiniteZeroForTheTruthAndFallWithSamples)
     ASSERT_FALSE(rows.empty());
     std::map<std::string, double> rmse;
     for (const auto& r : rows) {
+        if (r.at("method") == "truth_check") continue;  // checked below
         const double e = std::stod(r.at("rmse")), t = std::stod(r.at("seconds"));
         EXPECT_TRUE(std::isfinite(e) && e >= 0.0) << r.at("method") << " " << r.at("setting");
         EXPECT_TRUE(std::isfinite(t) && t > 0.0) << r.at("method") << " " << r.at("setting");
@@ -132,6 +141,143 @@ TEST_F(Compare, FlickerIsMeasuredForTheThreeMethods)
         const double f = std::stod(r.at("flicker"));
         EXPECT_TRUE(std::isfinite(f) && f >= 0.0) << r.at("method");
     }
+}
+
+// Independent of compareImages: both images' RGB box-downsampled first, luminance after.
+struct BlockErrors {
+    double rmse = 0.0, mae = 0.0;
+};
+BlockErrors downsampledErrors(const Image& a, const Image& b, int k)
+{
+    const int bw = a.width / k, bh = a.height / k;
+    double sq = 0.0, abs = 0.0;
+    for (int by = 0; by < bh; ++by) {
+        for (int bx = 0; bx < bw; ++bx) {
+            double d = 0.0;
+            for (int y = by * k; y < by * k + k; ++y) {
+                for (int x = bx * k; x < bx * k + k; ++x) {
+                    const double w[3] = {0.2126, 0.7152, 0.0722};
+                    for (int c = 0; c < 3; ++c) d += w[c] * (a.pixel(x, y)[c] - b.pixel(x, y)[c]);
+                }
+            }
+            d /= double(k * k);
+            sq += d * d;
+            abs += std::abs(d);
+        }
+    }
+    return {std::sqrt(sq / (bw * bh)), abs / (bw * bh)};
+}
+
+// [tree, coverage_px, luminance] per tree, as the EXR header carries them, read here as JSON.
+std::map<int, std::pair<double, double>> treeSums(const Metadata& header)
+{
+    std::map<int, std::pair<double, double>> out;
+    for (const auto& [key, value] : header) {
+        if (key != "pine:tree_foliage") continue;
+        for (const auto& t : nlohmann::json::parse(std::get<std::string>(value))) {
+            out[t[0].get<int>()] = {t[1].get<double>(), t[2].get<double>()};
+        }
+    }
+    return out;
+}
+
+TEST_F(Compare, ReportNumbersAreWhatTheWrittenImagesGive)
+{
+    ASSERT_EQ(status, 0);
+    const fs::path out = dir / "out";
+    const Table rows = readCsv(out / "report.csv");
+    Metadata truthHeader;
+    const Image truth = readExr(out / "truth_16spp.exr", &truthHeader);
+    const auto truthTrees = treeSums(truthHeader);
+    ASSERT_FALSE(truthTrees.empty()) << "the truth's EXR carries no tree sums";
+    const auto close = [](double got, double want) {
+        return std::abs(got - want) <= 1e-6 * std::abs(want) + 1e-12;
+    };
+    int checkedTrees = 0;
+    bool sawCheck = false;
+    for (const auto& r : rows) {
+        const std::string name = r.at("method") + "_" + r.at("setting");
+        if (r.at("method") == "truth_check") {
+            sawCheck = true;
+            EXPECT_GT(std::stod(r.at("rmse_k1")), 0.0);
+            continue;
+        }
+        if (r.at("method") == "truth") continue;
+        EXPECT_LE(std::stod(r.at("seconds_min")), std::stod(r.at("seconds"))) << name;
+        EXPECT_LE(std::stod(r.at("seconds")), std::stod(r.at("seconds_max"))) << name;
+        Metadata header;
+        const Image image = readExr(out / (name + ".exr"), &header);
+        for (const int k : {1, 2, 4, 8, 16}) {
+            const std::string rmse = r.at("rmse_k" + std::to_string(k));
+            if (image.width / k < 1 || image.height / k < 1) {
+                EXPECT_EQ(rmse, "") << name << " k " << k;
+                continue;
+            }
+            const BlockErrors e = downsampledErrors(image, truth, k);
+            EXPECT_TRUE(close(std::stod(rmse), e.rmse))
+                << name << " k " << k << ": " << rmse << " against " << e.rmse;
+            EXPECT_TRUE(close(std::stod(r.at("mae_k" + std::to_string(k))), e.mae))
+                << name << " k " << k;
+        }
+        EXPECT_TRUE(close(std::stod(r.at("rmse")), downsampledErrors(image, truth, 1).rmse));
+        // Per tree: coverage and mean luminance against the truth's, trees of >= 20 pixels.
+        const auto trees = treeSums(header);
+        if (trees.empty()) {
+            EXPECT_EQ(r.at("tree_luminance_median"), "") << name;
+            continue;
+        }
+        std::vector<double> luminance, coverage;
+        double cov = 0, lum = 0, covTruth = 0, lumTruth = 0;
+        for (const auto& [tree, sums] : truthTrees) {
+            covTruth += sums.first;
+            lumTruth += sums.second;
+            if (sums.first < 20.0) continue;
+            const auto it = trees.find(tree);
+            const double c = it == trees.end() ? 0.0 : it->second.first;
+            const double l = it == trees.end() || c <= 0.0 ? 0.0 : it->second.second / c;
+            coverage.push_back(c / sums.first - 1.0);
+            luminance.push_back(l / (sums.second / sums.first) - 1.0);
+        }
+        for (const auto& [tree, sums] : trees) {
+            cov += sums.first;
+            lum += sums.second;
+        }
+        const auto median = [](std::vector<double> v) {
+            std::sort(v.begin(), v.end());
+            const std::size_t n = v.size();
+            return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+        };
+        ASSERT_FALSE(luminance.empty()) << name;
+        EXPECT_EQ(std::stoul(r.at("trees")), luminance.size()) << name;
+        EXPECT_TRUE(close(std::stod(r.at("tree_luminance_median")), median(luminance))) << name;
+        EXPECT_TRUE(close(std::stod(r.at("tree_coverage_median")), median(coverage))) << name;
+        EXPECT_TRUE(close(std::stod(r.at("foliage_coverage_bias")), cov / covTruth - 1.0)) << name;
+        EXPECT_TRUE(close(std::stod(r.at("foliage_luminance_bias")),
+                          (lum / cov) / (lumTruth / covTruth) - 1.0))
+            << name;
+        ++checkedTrees;
+    }
+    EXPECT_TRUE(sawCheck) << "no truth_check row";
+    EXPECT_GE(checkedTrees, 6) << "geometry and multiscale rows should all carry their trees";
+}
+
+TEST(CompareRun, EffectsTheMethodsCannotShareAreRefused)
+{
+    scenes::Effects effects;
+    effects.shadows = true;
+    try {
+        checkEffects(effects);
+        ADD_FAILURE() << "shadows without self_shadowing were accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("self_shadowing"), std::string::npos) << e.what();
+    }
+    effects.shadows = false;
+    effects.selfShadowing = true;
+    EXPECT_THROW(checkEffects(effects), InputError);
+    effects.shadows = true;
+    EXPECT_NO_THROW(checkEffects(effects));
+    effects.shadows = effects.selfShadowing = false;
+    EXPECT_NO_THROW(checkEffects(effects));
 }
 
 TEST(CompareRun, UnwritableFolderFailsBeforeWork)

@@ -37,6 +37,8 @@ CompareRun runCompare(const CompareOptions& options)
     loadImageIo();
     scenes::Scene scene = scenes::loadScene(options.sceneFile);
     if (options.model) options.model(scene.render.model);
+    if (options.addSelfShadowing) scene.effects.selfShadowing = true;
+    checkEffects(scene.effects);
     if (options.width > 0 && options.height > 0) {
         // fov_deg is vertical: the view is kept, and kept exactly when the aspect is.
         scene.camera.width = options.width;
@@ -63,7 +65,8 @@ CompareRun runCompare(const CompareOptions& options)
     info.machine = options.machine;
     info.errorScale = commonErrorScale(run.rows);
     writeRowImages(run, options.sceneFile, scene, info.errorScale, dir);
-    io::writeTextAtomically(dir / "report.csv", reportCsv(run.rows));
+    io::writeTextAtomically(dir / "report.csv", reportCsv(run));
+    io::writeTextAtomically(dir / "trees.csv", treesCsv(run));
     if (options.plot) {
         info.plotted = options.plot(dir);
         if (!info.plotted) {
@@ -89,7 +92,7 @@ CompareRun runCompare(const CompareOptions& options)
                " s";
     if (const CompareRow* ms = findRow(run.rows, "multiscale", "auto")) {
         summary += "; multiscale (auto) rmse " + formatNumber(ms->errors.rmse) + " in " +
-                   formatNumber(ms->seconds, 3) + " s";
+                   formatNumber(ms->seconds, 3) + " CPU-s";
         if (const CompareRow* g = cheapestGeometryWithin(run.rows, ms->errors.rmse)) {
             summary += ", speed ratio " + formatNumber(g->seconds / ms->seconds, 3) +
                        " over geometry " + g->setting;

@@ -16,34 +16,188 @@ bool hasLevels(const CompareRow& row)
     return row.method == "multiscale" && !row.errors.byLevel.empty();
 }
 
-std::string speedSection(const std::vector<CompareRow>& rows)
+// The scale at which "equal error" is stated besides per pixel (issue: a fair comparison).
+constexpr int kNamedScale = 4;
+
+std::string percent(double fraction)
+{
+    return formatNumber(100.0 * fraction, 3) + "%";
+}
+
+std::string scaleSection(const CompareRun& run, bool plotted)
+{
+    std::ostringstream s;
+    s << "Both images box-downsampled by k (each whole k x k block's mean; "
+         "`ImageErrors::byScale`), then the luminance error over the blocks. A method's noise "
+         "falls as 1 / k, its bias stays.\n\n| method | setting |";
+    for (const int k : kErrorScales) s << " RMSE k=" << k << " |";
+    for (const int k : kErrorScales) s << " MAE k=" << k << " |";
+    s << "\n|---|---|";
+    for (std::size_t i = 0; i < 2 * std::size(kErrorScales); ++i) s << "---|";
+    s << '\n';
+    for (const CompareRow& r : run.rows) {
+        if (r.truth) continue;
+        s << "| " << r.method << " | " << r.setting << " |";
+        for (const int k : kErrorScales) {
+            const ImageErrors::AtScale* a = r.errors.atScale(k);
+            s << ' ' << (a ? formatNumber(a->rmse) : "-") << " |";
+        }
+        for (const int k : kErrorScales) {
+            const ImageErrors::AtScale* a = r.errors.atScale(k);
+            s << ' ' << (a ? formatNumber(a->mae) : "-") << " |";
+        }
+        s << '\n';
+    }
+    if (run.truthCheck) {
+        s << "| truth's own error | against " << run.truthCheck->samples << " spp |";
+        for (const int k : kErrorScales) {
+            const ImageErrors::AtScale* a = run.truthCheck->errors.atScale(k);
+            s << ' ' << (a ? formatNumber(a->rmse) : "-") << " |";
+        }
+        for (const int k : kErrorScales) {
+            const ImageErrors::AtScale* a = run.truthCheck->errors.atScale(k);
+            s << ' ' << (a ? formatNumber(a->mae) : "-") << " |";
+        }
+        s << '\n';
+    }
+    if (plotted) s << "\n![RMSE against scale](error_vs_scale.png)\n";
+    return s.str();
+}
+
+std::string truthSection(const CompareRun& run, const CompareSettings& st)
+{
+    std::ostringstream s;
+    s << "The truth is the geometry method (explicit needles) at " << st.truthSamples
+      << " samples per pixel on its own shift of the sample sequence (seed " << st.truthSeed
+      << "; the sweep's renders use seed 0), so that its noise is independent of theirs.";
+    if (!run.truthCheck) {
+        s << " Its convergence was not checked (truthCheckFactor 0).\n";
+        return s.str();
+    }
+    const double own = run.truthCheck->errors.rmse;
+    double least = -1.0;
+    const CompareRow* closest = nullptr;
+    for (const CompareRow& r : run.rows) {
+        if (!r.truth && (!closest || r.errors.rmse < least)) {
+            least = r.errors.rmse;
+            closest = &r;
+        }
+    }
+    s << " Against a render of " << run.truthCheck->samples
+      << " samples per pixel (another seed) its own RMSE is " << formatNumber(own) << " per pixel";
+    if (const ImageErrors::AtScale* a = run.truthCheck->errors.atScale(kNamedScale)) {
+        s << " and " << formatNumber(a->rmse) << " at k = " << kNamedScale;
+    }
+    s << ".";
+    if (closest) {
+        s << " The closest render of the sweep, " << closest->method << ' ' << closest->setting
+          << ", has " << formatNumber(least) << " per pixel: ";
+        if (own <= least / 3.0) {
+            s << "the truth's own error is at most a third of it, so the truth is converged "
+                 "enough for this comparison.";
+        } else {
+            s << "**the truth's own error is more than a third of it: the truth is not "
+                 "converged enough to rank the closest renders**; use more truth samples.";
+        }
+    }
+    s << '\n';
+    return s.str();
+}
+
+std::string treeSection(const CompareRun& run)
+{
+    std::ostringstream s;
+    const CompareRow& truth = run.rows.front();
+    if (truth.treeFoliage.empty()) return "The truth knows no trees: no per-tree bias.\n";
+    s << "Each tree's foliage summed fragment by fragment by each render (a pixel two trees "
+         "share gives each its part; `tree_foliage_tally.h`): its coverage and its mean "
+         "foliage luminance against the truth's, for the trees the truth shows over at least "
+         "20 pixels ("
+      << truth.treeFoliage.size() << " trees shown, ";
+    std::size_t compared = 0;
+    for (const CompareRow& r : run.rows) compared = std::max(compared, r.trees.trees);
+    s << compared << " compared). Median, worst (with its tree) and trees off by more than "
+      << "3%; \"all foliage\" sums every tree. Every tree's numbers: trees.csv.\n\n"
+         "| method | setting | all foliage: coverage | luminance | per tree, luminance: "
+         "median | worst | > 3% | coverage: median | worst | > 3% |\n"
+         "|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const CompareRow& r : run.rows) {
+        if (r.truth) continue;
+        s << "| " << r.method << " | " << r.setting << " | ";
+        if (!r.foliageCoverageBias || !r.trees.trees) {
+            s << "(knows no trees) | | | | | | | |\n";
+            continue;
+        }
+        const auto& l = r.trees.luminance;
+        const auto& c = r.trees.coverage;
+        s << percent(*r.foliageCoverageBias) << " | " << percent(*r.foliageLuminanceBias) << " | "
+          << percent(l.median) << " | " << percent(l.worst) << " (tree " << l.worstTree << ") | "
+          << l.beyond << " | " << percent(c.median) << " | " << percent(c.worst) << " (tree "
+          << c.worstTree << ") | " << c.beyond << " |\n";
+    }
+    return s.str();
+}
+
+double rmseAt(const CompareRow& row, int k)
+{
+    const ImageErrors::AtScale* a = row.errors.atScale(k);
+    return a ? a->rmse : row.errors.rmse;
+}
+
+// The fastest geometry render (not the truth) whose RMSE at scale k is at most `rmse`.
+const CompareRow* cheapestGeometryAt(const std::vector<CompareRow>& rows, int k, double rmse)
+{
+    const CompareRow* cheapest = nullptr;
+    for (const CompareRow& r : rows) {
+        if (r.method == "geometry" && rmseAt(r, k) <= rmse &&
+            (!cheapest || r.seconds < cheapest->seconds)) {
+            cheapest = &r;
+        }
+    }
+    return cheapest;
+}
+
+std::string speedAt(const std::vector<CompareRow>& rows, int k)
 {
     std::ostringstream s;
     const CompareRow* ms = findRow(rows, "multiscale", "auto");
     if (!ms) return "Multiscale (auto) was not rendered.\n";
-    const CompareRow* cheapest = cheapestGeometryWithin(rows, ms->errors.rmse);
-    const CompareRow* best = nullptr;
-    for (const CompareRow& r : rows) {
-        if (r.method == "geometry" && (!best || r.errors.rmse < best->errors.rmse)) best = &r;
-    }
-    s << "Multiscale (auto): RMSE " << formatNumber(ms->errors.rmse) << " in "
-      << formatNumber(ms->seconds, 3) << " s.\n\n";
+    const double e = rmseAt(*ms, k);
+    const CompareRow* cheapest = cheapestGeometryAt(rows, k, e);
+    s << "- **" << (k == 1 ? "per pixel (k = 1)" : "at k = " + std::to_string(k))
+      << "**: multiscale (auto) RMSE " << formatNumber(e) << " in " << formatNumber(ms->seconds, 3)
+      << " CPU-s. ";
     if (cheapest) {
         const double ratio = cheapest->seconds / ms->seconds;
-        s << "The cheapest geometry setting at equal or lower RMSE is " << cheapest->setting
-          << " (RMSE " << formatNumber(cheapest->errors.rmse) << ", "
-          << formatNumber(cheapest->seconds, 3)
-          << " s, its BVH included): speed ratio (geometry s / multiscale s) **"
-          << formatNumber(ratio, 3) << "**, i.e. "
-          << (ratio >= 1.0 ? "multiscale is " + formatNumber(ratio, 3) + " times faster"
-                           : "the geometry is " + formatNumber(1.0 / ratio, 3) + " times faster")
-          << " at equal or lower error.\n";
-    } else if (best) {
-        s << "**No geometry setting of the sweep reached multiscale's RMSE** (the best, "
-          << best->setting << ", has " << formatNumber(best->errors.rmse) << " in "
-          << formatNumber(best->seconds, 3) << " s); no ratio is extrapolated.\n";
+        s << "The cheapest geometry setting at equal or lower RMSE is " << cheapest->setting << " ("
+          << formatNumber(rmseAt(*cheapest, k)) << ", " << formatNumber(cheapest->seconds, 3)
+          << " CPU-s, its BVH included): speed ratio "
+          << "(geometry / multiscale) **" << formatNumber(ratio, 3) << "**, "
+          << (ratio >= 1.0 ? "multiscale " + formatNumber(ratio, 3) + " times faster"
+                           : "geometry " + formatNumber(1.0 / ratio, 3) + " times faster")
+          << ".\n";
+    } else {
+        const CompareRow* best = nullptr;
+        for (const CompareRow& r : rows) {
+            if (r.method == "geometry" && (!best || rmseAt(r, k) < rmseAt(*best, k))) best = &r;
+        }
+        s << "**No geometry setting of the sweep reaches it**";
+        if (best) {
+            s << " (the best, " << best->setting << ", has " << formatNumber(rmseAt(*best, k))
+              << " in " << formatNumber(best->seconds, 3) << " CPU-s)";
+        }
+        s << "; no ratio is extrapolated.\n";
     }
     return s.str();
+}
+
+std::string speedSection(const std::vector<CompareRow>& rows)
+{
+    return speedAt(rows, 1) + speedAt(rows, kNamedScale) + '\n' +
+           "At k = " + std::to_string(kNamedScale) +
+           " a block of pixels averages the needles' texture, as a viewer a little farther "
+           "away sees it: a per-pixel noise falls by k there, a bias does not, so a method "
+           "that is noisy but unbiased gains on one that is smooth but biased.\n";
 }
 
 std::string levelSection(const std::vector<CompareRow>& rows)
@@ -97,22 +251,75 @@ std::string levelSection(const std::vector<CompareRow>& rows)
 
 }  // namespace
 
-std::string reportCsv(const std::vector<CompareRow>& rows)
+std::string reportCsv(const CompareRun& run)
 {
     std::ostringstream s;
-    s << "method,setting,seconds,rmse,mean_relative,max_absolute,rmse_needle,rmse_cone,"
-         "rmse_bough,prep_seconds\n";
-    s << std::setprecision(6);
-    for (const CompareRow& r : rows) {
-        s << r.method << ',' << r.setting << ',' << r.seconds << ',' << r.errors.rmse << ','
-          << r.errors.meanRelative << ',' << r.errors.maxAbsolute;
+    s << "method,setting,seconds,seconds_min,seconds_max,wall_seconds,runs,prep_seconds,rmse,"
+         "mean_relative,max_absolute,rmse_needle,rmse_cone,rmse_bough";
+    for (const int k : kErrorScales) s << ",rmse_k" << k;
+    for (const int k : kErrorScales) s << ",mae_k" << k;
+    s << ",foliage_coverage_bias,foliage_luminance_bias,trees,tree_luminance_median,"
+         "tree_luminance_worst,tree_luminance_worst_tree,trees_luminance_beyond_3pct,"
+         "tree_coverage_median,tree_coverage_worst,tree_coverage_worst_tree,"
+         "trees_coverage_beyond_3pct\n";
+    s << std::setprecision(9);
+    const auto errorColumns = [&](const ImageErrors& e) {
+        for (const int k : kErrorScales) {
+            s << ',';
+            if (const ImageErrors::AtScale* a = e.atScale(k)) s << a->rmse;
+        }
+        for (const int k : kErrorScales) {
+            s << ',';
+            if (const ImageErrors::AtScale* a = e.atScale(k)) s << a->mae;
+        }
+    };
+    for (const CompareRow& r : run.rows) {
+        s << r.method << ',' << r.setting << ',' << r.seconds << ',' << r.secondsMin << ','
+          << r.secondsMax << ',' << r.wallSeconds << ',' << r.runs << ',';
+        if (r.prepSeconds) s << *r.prepSeconds;
+        s << ',' << r.errors.rmse << ',' << r.errors.meanRelative << ',' << r.errors.maxAbsolute;
         for (int level = 1; level <= 3; ++level) {
             s << ',';
             if (hasLevels(r) && r.errors.byLevel[level].pixels) s << r.errors.byLevel[level].rmse;
         }
+        errorColumns(r.errors);
         s << ',';
-        if (r.prepSeconds) s << *r.prepSeconds;
+        if (r.foliageCoverageBias) s << *r.foliageCoverageBias;
+        s << ',';
+        if (r.foliageLuminanceBias) s << *r.foliageLuminanceBias;
+        if (r.trees.trees) {
+            const auto& l = r.trees.luminance;
+            const auto& c = r.trees.coverage;
+            s << ',' << r.trees.trees << ',' << l.median << ',' << l.worst << ',' << l.worstTree
+              << ',' << l.beyond << ',' << c.median << ',' << c.worst << ',' << c.worstTree << ','
+              << c.beyond;
+        } else {
+            s << ",,,,,,,,,";
+        }
         s << '\n';
+    }
+    if (run.truthCheck) {
+        const ImageErrors& e = run.truthCheck->errors;
+        s << "truth_check," << run.truthCheck->samples << "spp,,,,,,," << e.rmse << ','
+          << e.meanRelative << ',' << e.maxAbsolute << ",,,";
+        errorColumns(e);
+        s << ",,,,,,,,,,,\n";
+    }
+    return s.str();
+}
+
+std::string treesCsv(const CompareRun& run)
+{
+    std::ostringstream s;
+    s << "method,setting,tree,coverage_px,coverage_px_truth,coverage_bias,luminance,"
+         "luminance_truth,luminance_bias\n"
+      << std::setprecision(9);
+    for (const CompareRow& r : run.rows) {
+        for (const TreeBias& t : r.treeBiases) {
+            s << r.method << ',' << r.setting << ',' << t.truth.tree << ',' << t.image.coverage
+              << ',' << t.truth.coverage << ',' << t.coverageBias << ',' << t.image.luminance << ','
+              << t.truth.luminance << ',' << t.luminanceBias << '\n';
+        }
     }
     return s.str();
 }
@@ -153,6 +360,9 @@ void writeRowImages(const CompareRun& run, const std::filesystem::path& sceneFil
                            {"pine:method", r.method},
                            {"pine:setting", r.setting},
                            {"pine:render_seconds", float(r.seconds)}});
+        if (!r.treeFoliage.empty()) {
+            m.emplace_back(kTreeFoliageAttribute, treeFoliageText(r.treeFoliage));
+        }
         writeExr(exrImage(r.image, camera, renderMethod(r.renderer),
                           EffectsPlan::from(scene.effects)),
                  dir / (r.stem() + ".exr"), m);
@@ -170,27 +380,47 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
     s << "- scene: `" << c.sceneFile.string() << "`, " << scene.camera.width << " x "
       << scene.camera.height << " pixels\n";
     s << "- machine: " << c.machine << "\n";
-    s << "- ground truth: geometry (explicit needles) at " << st.truthSamples << " spp\n";
+    s << "- load averages (1, 5, 15 min): " << run.load << "\n";
+    s << "- effects, the same for every method:";
+    for (const auto& [on, name] : {std::pair{scene.effects.diffuse, "diffuse"},
+                                   std::pair{scene.effects.specular, "specular"},
+                                   std::pair{scene.effects.shadows, "shadows"},
+                                   std::pair{scene.effects.selfShadowing, "self_shadowing"}}) {
+        if (on) s << ' ' << name;
+    }
+    s << " (`checkEffects`: explicit needles and baked volumes shadow and self-shadow "
+         "together, so a scene naming one alone is refused)\n";
+    s << "- ground truth: geometry (explicit needles) at " << st.truthSamples << " spp, seed "
+      << st.truthSeed << "\n";
     s << "- geometry:";
     for (int n : st.geometrySamples) s << ' ' << n;
     s << " spp; reference: voxels of";
     for (double h : st.voxelSizes_cm) s << ' ' << formatNumber(h);
     s << " cm, " << st.subpixels * st.subpixels << " rays per pixel; multiscale: levels forced "
       << "to 1, 2, 3 and automatic\n";
+    s << "- times: process CPU seconds (all threads) of each render, the median of " << st.repeat
+      << " run(s) by CPU seconds [the least, the most], what the method prepares first "
+         "included (prep: the geometry's Embree BVH, the reference's bake and light grids, in "
+         "wall seconds); the multiscale times include the bough law's per-bough profiles, "
+         "computed as the render first needs them, each run from a scene of its own\n";
     s << "- scene build (trees grown, BVH): " << formatNumber(run.buildSeconds, 3)
-      << " s, excluded from every time below; the multiscale times include the bough law's "
-         "per-bough profiles, computed as the render first needs them\n\n";
+      << " s wall, excluded from every time below\n\n";
+    s << "## The truth\n\n" << truthSection(run, st) << '\n';
     s << "## Error against time\n\n"
-         "Seconds: wall clock of each render alone, including what the method alone needs "
-         "first (prep: the geometry's Embree BVH, the reference's bake and light grids). Errors: "
-         "linear "
-         "luminance of premultiplied RGB against the ground truth (`compareImages`): RMSE over "
-         "all pixels, mean relative over pixels brighter than 1% of the truth's mean, maximum, "
-         "and for multiscale the RMSE over the pixels of each level.\n\n";
-    s << "| method | setting | seconds | prep s | RMSE | mean relative | max | RMSE needle | "
-         "RMSE cone | RMSE bough |\n|---|---|---|---|---|---|---|---|---|---|\n";
+         "Errors: linear luminance of premultiplied RGB against the ground truth "
+         "(`compareImages`): RMSE over all pixels, mean relative over pixels brighter than 1% "
+         "of the truth's mean, maximum, and for multiscale the RMSE over the pixels of each "
+         "level.\n\n";
+    s << "| method | setting | CPU s | [least, most] | wall s | prep s | RMSE | mean relative | "
+         "max | RMSE needle | RMSE cone | RMSE bough |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const CompareRow& r : rows) {
-        s << "| " << r.method << " | " << r.setting << " | " << formatNumber(r.seconds, 3) << " | "
+        s << "| " << r.method << " | " << r.setting << " | " << formatNumber(r.seconds, 3) << " | ";
+        if (r.runs > 1) {
+            s << '[' << formatNumber(r.secondsMin, 3) << ", " << formatNumber(r.secondsMax, 3)
+              << ']';
+        }
+        s << " | " << formatNumber(r.wallSeconds, 3) << " | "
           << (r.prepSeconds ? formatNumber(*r.prepSeconds, 3) : "") << " | "
           << formatNumber(r.errors.rmse) << " | " << formatNumber(r.errors.meanRelative) << " | "
           << formatNumber(r.errors.maxAbsolute);
@@ -202,9 +432,12 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
         }
         s << " |\n";
     }
-    s << "\nThe same in [report.csv](report.csv).\n\n";
-    if (c.plotted) s << "![RMSE against seconds](error_vs_time.png)\n\n";
+    s << "\nEvery number of this report is in [report.csv](report.csv) (the truth's own error "
+         "as the row `truth_check`), each tree's in [trees.csv](trees.csv).\n\n";
+    if (c.plotted) s << "![RMSE against CPU seconds](error_vs_time.png)\n\n";
+    s << "## Error at every scale\n\n" << scaleSection(run, c.plotted) << '\n';
     s << "## Speed at equal error\n\n" << speedSection(rows) << '\n';
+    s << "## Bias per tree\n\n" << treeSection(run) << '\n';
     s << "## Where the linear law's error shows\n\n" << levelSection(rows) << '\n';
     s << "## Images\n\nPreviews over the scene's background; error maps of the luminance error "
          "from 0 (black) to "

@@ -1,34 +1,105 @@
 #include "pine/vdbtrace/compare_run.h"
 
+#include "pine/support/input_error.h"
+#include "pine/support/process_clock.h"
 #include "pine/vdbtrace/methods.h"
 
+#include <algorithm>
+#include <fstream>
 #include <iomanip>
 #include <sstream>
 
 namespace pine::vdbtrace {
 namespace {
 
-CompareRow render(const TracedScene& traced, const std::string& method, std::string label,
-                  std::string setting, const MethodSettings& settings)
+// Renders `repeat` times, each run from the scene `sceneFor(run)` gives.
+CompareRow render(const std::function<const TracedScene&(int run)>& sceneFor,
+                  const std::string& method, std::string label, std::string setting,
+                  const MethodSettings& settings, int repeat)
 {
-    RenderResult r = renderMethod(method).render(traced, settings, {});
+    struct Run {
+        double cpu, wall, prep;
+    };
+    std::vector<Run> runs;
     CompareRow row;
+    for (int i = 0; i < std::max(1, repeat); ++i) {
+        const TracedScene& scene = sceneFor(i);
+        const double cpu = io::processCpuSeconds();
+        RenderResult r = renderMethod(method).render(scene, settings, {});
+        runs.push_back({io::processCpuSeconds() - cpu, r.seconds, r.prepSeconds});
+        if (i == 0) {  // every run renders the same image
+            row.image = std::move(r.image);
+            row.treeFoliage = std::move(r.treeFoliage);
+        }
+    }
+    std::sort(runs.begin(), runs.end(), [](const Run& a, const Run& b) { return a.cpu < b.cpu; });
+    const Run& median = runs[runs.size() / 2];
     row.method = std::move(label);
     row.renderer = method;
     row.setting = std::move(setting);
-    row.seconds = r.seconds;
-    if (method != "multiscale") row.prepSeconds = r.prepSeconds;
-    row.image = std::move(r.image);
+    row.seconds = median.cpu;
+    row.secondsMin = runs.front().cpu;
+    row.secondsMax = runs.back().cpu;
+    row.wallSeconds = median.wall;
+    row.runs = int(runs.size());
+    if (method != "multiscale") row.prepSeconds = median.prep;
     return row;
 }
 
+// The load averages over 1, 5 and 15 minutes, as /proc/loadavg has them.
+std::string loadAverages()
+{
+    std::ifstream in("/proc/loadavg");
+    double a = 0, b = 0, c = 0;
+    if (!(in >> a >> b >> c)) return "unknown";
+    std::ostringstream s;
+    s << a << ' ' << b << ' ' << c;
+    return s.str();
+}
+
+// Biases against the truth, where both know their trees.
+void measureTrees(CompareRow& row, const CompareRow& truth)
+{
+    if (row.treeFoliage.empty() || truth.treeFoliage.empty()) return;
+    row.treeBiases = treeBiases(row.treeFoliage, truth.treeFoliage);
+    row.trees = summarizeTreeBiases(row.treeBiases);
+    const auto total = [](const std::vector<TreeFoliageSum>& sums) {
+        TreeFoliageSum all;
+        for (const TreeFoliageSum& t : sums) {
+            all.coverage_px += t.coverage_px;
+            all.luminance += t.luminance;
+        }
+        return all;
+    };
+    const TreeFoliageSum a = total(row.treeFoliage), b = total(truth.treeFoliage);
+    if (b.coverage_px > 0.0 && b.luminance > 0.0 && a.coverage_px > 0.0) {
+        row.foliageCoverageBias = a.coverage_px / b.coverage_px - 1.0;
+        row.foliageLuminanceBias =
+            (a.luminance / a.coverage_px) / (b.luminance / b.coverage_px) - 1.0;
+    }
+}
+
 }  // namespace
+
+void checkEffects(const scenes::Effects& effects)
+{
+    if (effects.shadows == effects.selfShadowing) return;
+    throw InputError(
+        std::string("the scene names \"") + (effects.shadows ? "shadows" : "self_shadowing") +
+        "\" without \"" + (effects.shadows ? "self_shadowing" : "shadows") +
+        "\", which geometry and reference cannot render (their needles and voxels shade "
+        "through their own bough as through any other): add \"" +
+        (effects.shadows ? "self_shadowing" : "shadows") +
+        "\" to the scene's effects (or pass --self-shadowing) so that every method computes "
+        "the same effects");
+}
 
 CompareSettings CompareSettings::forQuick(bool quick)
 {
     CompareSettings s;
     if (quick) {
         s.truthSamples = 16;
+        s.repeat = 1;
         s.geometrySamples = {1, 4};
         s.voxelSizes_cm = {1.0, 0.5};
         s.frames = 8;
@@ -47,50 +118,84 @@ std::string formatNumber(double value, int digits)
 CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
                          const CompareLog& log)
 {
+    checkEffects(scene.effects);
     using Clock = std::chrono::steady_clock;
     CompareRun run;
+    run.load = loadAverages();
     const auto buildStart = Clock::now();
     const TracedScene traced = buildTracedScene(scene);
     run.buildSeconds = std::chrono::duration<double>(Clock::now() - buildStart).count();
     if (log) log("scene built in " + formatNumber(run.buildSeconds, 3) + " s");
+    const auto built = [&](int) -> const TracedScene& { return traced; };
+    // The bough law's profiles are computed as a multiscale render first needs them
+    // (traced_scene.h) and belong to its time: each run starts from a scene of its own, so
+    // that none inherits another's.
+    std::optional<TracedScene> own;
+    const auto builtAgain = [&](int) -> const TracedScene& {
+        own.reset();
+        own.emplace(buildTracedScene(scene));
+        return *own;
+    };
 
     const auto measure = [&](CompareRow row) {
         const CompareRow& truth = run.rows.empty() ? row : run.rows.front();
         row.errors = compareImages(row.image, truth.image);
+        measureTrees(row, truth);
         if (log) {
-            std::string line = row.method + " " + row.setting + ": " +
-                               formatNumber(row.seconds, 3) + " s";
-            if (row.prepSeconds)
+            std::string line =
+                row.method + " " + row.setting + ": " + formatNumber(row.seconds, 3) + " CPU-s";
+            if (row.runs > 1) {
+                line += " [" + formatNumber(row.secondsMin, 3) + ", " +
+                        formatNumber(row.secondsMax, 3) + "]";
+            }
+            if (row.prepSeconds) {
                 line += " (" + formatNumber(*row.prepSeconds, 3) + " s preparation)";
+            }
             if (!row.truth) line += ", rmse " + formatNumber(row.errors.rmse);
+            if (!row.truth && row.trees.trees) {
+                line += ", per-tree luminance median " +
+                        formatNumber(100.0 * row.trees.luminance.median, 3) + "%";
+            }
             log(line);
         }
         run.rows.push_back(std::move(row));
     };
     MethodSettings s;
     s.geometry.samples = st.truthSamples;
+    s.geometry.sampleSeed = st.truthSeed;
     CompareRow truth =
-        render(traced, "geometry", "truth", std::to_string(st.truthSamples) + "spp", s);
+        render(built, "geometry", "truth", std::to_string(st.truthSamples) + "spp", s, 1);
     truth.truth = true;
     measure(std::move(truth));
+    if (st.truthCheckFactor > 0) {
+        MethodSettings check = s;
+        check.geometry.samples = st.truthSamples * st.truthCheckFactor;
+        check.geometry.sampleSeed = st.truthSeed + 1;
+        if (check.geometry.sampleSeed == 0) ++check.geometry.sampleSeed;
+        const RenderResult r = renderMethod("geometry").render(traced, check, {});
+        run.truthCheck =
+            TruthCheck{check.geometry.samples, compareImages(run.rows.front().image, r.image)};
+        if (log) {
+            log("truth against " + std::to_string(check.geometry.samples) + " spp: rmse " +
+                formatNumber(run.truthCheck->errors.rmse));
+        }
+    }
+    s.geometry.sampleSeed = 0;
     for (int n : st.geometrySamples) {
         s.geometry.samples = n;
-        measure(render(traced, "geometry", "geometry", std::to_string(n) + "spp", s));
+        measure(render(built, "geometry", "geometry", std::to_string(n) + "spp", s, st.repeat));
     }
     s.reference.subpixels = st.subpixels;
     for (double h : st.voxelSizes_cm) {
         s.voxelSize_cm = h;
-        measure(render(traced, "reference", "reference", formatNumber(h) + "cm", s));
+        measure(render(built, "reference", "reference", formatNumber(h) + "cm", s, st.repeat));
     }
     for (int level : st.levels) {
         s.multiscale.forceLevel = level;
-        // The bough law's profiles are computed as a render first needs them (traced_scene.h)
-        // and belong to the multiscale method's time: each row starts from a scene of its own,
-        // so that none inherits another's.
-        const TracedScene fresh = buildTracedScene(scene);
-        measure(render(fresh, "multiscale", "multiscale",
-                       level ? "L" + std::to_string(level) : "auto", s));
+        measure(render(builtAgain, "multiscale", "multiscale",
+                       level ? "L" + std::to_string(level) : "auto", s, st.repeat));
     }
+    run.load += " before; " + loadAverages() + " after";
     return run;
 }
 

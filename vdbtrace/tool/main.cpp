@@ -7,6 +7,7 @@
 #include "pine/support/atomic_file.h"
 #include "pine/support/folder_lock.h"
 #include "pine/support/plot_script.h"
+#include "pine/support/process_clock.h"
 #include "pine/support/progress.h"
 #include "pine/support/tool_main.h"
 #include "pine/vdbtrace/compare.h"
@@ -15,7 +16,6 @@
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
-#include "pine/vdbtrace/tree_foliage.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
@@ -24,6 +24,7 @@
 #include "pine/vdbtrace/scene_growth.h"
 #include "pine/vdbtrace/stats_json.h"
 #include "pine/vdbtrace/traced_scene.h"
+#include "pine/vdbtrace/tree_foliage.h"
 
 #include <CLI/CLI.hpp>
 #include <tbb/task_arena.h>
@@ -485,11 +486,11 @@ BenchRun benchRun(const scenes::Scene& scene, const std::string& method,
     run.boughs = traced.boughs.size();
     for (const scenes::TreeCounts& counts : traced.treeCounts) run.needles += counts.needles;
     tool::Progress shown("vdbtrace: " + label);
-    const double cpu = tool::processCpuSeconds();
+    const double cpu = io::processCpuSeconds();
     const auto start = Clock::now();
     run.result = vdbtrace::renderMethod(method).render(traced, settings, withProgress(shown));
     run.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
-    run.cpuSeconds = tool::processCpuSeconds() - cpu;
+    run.cpuSeconds = io::processCpuSeconds() - cpu;
     run.profiles = vdbtrace::lawProfileCounts(traced);
     run.columnsBytes = vdbtrace::lightColumnsBytes(traced);
     return run;
@@ -528,7 +529,7 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
         io::checkWritable(jsonFile);
         io::checkOutputsApart({jsonFile}, {sceneFile});
     }
-    const double startupCpu = tool::processCpuSeconds();
+    const double startupCpu = io::processCpuSeconds();
     scenes::Scene scene = scenes::loadScene(sceneFile);
     model.apply(scene.render.model);
     if (width > 0) {  // --resolution: the same view, its vertical field kept
@@ -625,9 +626,9 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
         const auto scaled = [&](const scenes::Scene& s, const std::string& label,
                                 double& lawCpuSeconds) {
             const vdbtrace::TracedScene traced = vdbtrace::buildTracedScene(s);
-            const double cpu = tool::processCpuSeconds();
+            const double cpu = io::processCpuSeconds();
             vdbtrace::computeLawProfiles(traced);
-            lawCpuSeconds = tool::processCpuSeconds() - cpu;
+            lawCpuSeconds = io::processCpuSeconds() - cpu;
             tool::Progress shown("vdbtrace: " + label);
             return perBoughPixel(
                 vdbtrace::renderMultiscale(traced, settings.multiscale, withProgress(shown)));
@@ -796,7 +797,7 @@ std::string machineDescription()
 bool plotCompare(const fs::path& dir)
 {
     return tool::runPlotScript(tool::plotScript("plot_compare.py"), dir) &&
-           fs::exists(dir / "error_vs_time.png");
+           fs::exists(dir / "error_vs_time.png") && fs::exists(dir / "error_vs_scale.png");
 }
 
 int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double scale)
@@ -1068,9 +1069,11 @@ int main(int argc, char** argv)
     vdbtrace::CompareOptions compare;
     bool quick = false, noPlot = false;
     std::string resolution;
-    auto* compareCmd = app.add_subcommand(
-        "compare", "Every method and setting against the geometry ground truth: time, error, "
-                   "flicker (report.md, report.csv, images, error_vs_time.png)");
+    auto* compareCmd =
+        app.add_subcommand("compare",
+                           "Every method and setting against the geometry ground truth: CPU time, "
+                           "error at every scale, bias per tree, flicker (report.md, report.csv, "
+                           "trees.csv, images, error_vs_time.png, error_vs_scale.png)");
     compareCmd->add_option("scene", compare.sceneFile, "Scene file (JSON)")->required();
     compareCmd->add_option("--out-dir", compare.outDir, "Folder for the report and images")
         ->required();
@@ -1078,7 +1081,12 @@ int main(int argc, char** argv)
                          "Fewer settings (truth 16 spp, geometry 1 and 4 spp, voxels 1 and "
                          "0.5 cm) and an 8-frame dolly at half resolution");
     addResolution(*compareCmd, resolution, "WxH instead of the camera's (same view)", "64x48");
-    compareCmd->add_flag("--no-plot", noPlot, "Skip error_vs_time.png (matplotlib)");
+    compareCmd->add_flag("--no-plot", noPlot,
+                         "Skip error_vs_time.png and error_vs_scale.png (matplotlib)");
+    compareCmd->add_flag("--self-shadowing", compare.addSelfShadowing,
+                         "Add self_shadowing to the scene's effects: the explicit needles "
+                         "always self-shadow, so a scene with shadows alone is refused "
+                         "without it");
     addMaxMemory(*compareCmd, maxMemoryGiB, "a comparison");
     model.add(*compareCmd);
 

@@ -34,7 +34,5 @@ double peakMemoryMiB();
 bool resetPeakMemory();
 /// The peak resident memory since the last resetPeakMemory() (VmHWM), in MiB.
 double peakMemoryMiBSinceReset();
-/// CPU seconds the process has used so far, all threads (user and system).
-double processCpuSeconds();
 
 }  // namespace pine::tool

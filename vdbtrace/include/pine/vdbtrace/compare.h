@@ -17,18 +17,23 @@ struct CompareOptions {
     /// Adjusts the scene's model choices after it is read (the command line's overrides).
     std::function<void(scenes::ModelChoices&)> model;
     int width = 0, height = 0;  ///< override of the camera's resolution (0: the scene's)
+    /// Adds "self_shadowing" to the scene's effects: the explicit needles always self-shadow,
+    /// so a scene with "shadows" alone is compared with both (checkEffects).
+    bool addSelfShadowing = false;
     double maxMemoryBytes = 0.0;  ///< refuse, before any work, a run estimated to need more
     bool flicker = true;        ///< render the dolly (flicker.csv)
     std::string machine = "unknown machine";  ///< for the report: CPU, cores, threads
     CompareLog log;             ///< progress lines for a person; the last one sums up
     CompareLog warn;            ///< what went wrong but did not stop the run (null: to log)
-    /// Draws error_vs_time.png from report.csv in the folder; true if it did. Null: no plot.
+    /// Draws error_vs_time.png and error_vs_scale.png from report.csv in the folder; true if
+    /// it did. Null: no plot.
     std::function<bool(const std::filesystem::path& dir)> plot;
 };
 
-/// Runs the comparison into `outDir` (created): report.csv, report.md, flicker.csv, each image
-/// as EXR + PNG preview + error map, error_vs_time.png if `plot` draws it. Throws InputError
-/// if `outDir` cannot be written (before any work), and what loading and rendering throw.
+/// Runs the comparison into `outDir` (created): report.csv, trees.csv, report.md, flicker.csv,
+/// each image as EXR + PNG preview + error map, error_vs_time.png and error_vs_scale.png if
+/// `plot` draws them. Throws InputError if `outDir` cannot be written or the methods cannot
+/// compute the scene's effects alike (before any work), and what loading and rendering throw.
 CompareRun runCompare(const CompareOptions& options);
 
 /// "WxH" -> width, height (both in [1, 16384], as a scene's camera); false if malformed.

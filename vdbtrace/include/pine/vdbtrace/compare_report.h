@@ -16,12 +16,16 @@ struct ReportInfo {
     CompareSettings settings;
     std::string machine;              ///< CPU, cores and threads, as the tool found them
     double errorScale = 1.0;          ///< luminance error shown white in every error map
-    bool plotted = false;             ///< error_vs_time.png exists
+    bool plotted = false;             ///< error_vs_time.png and error_vs_scale.png exist
     const DollyFlicker* flicker = nullptr;  ///< null: no dolly was rendered
 };
 
-/// One row a render: method, setting, seconds, errors (overall and by level), prep seconds.
-std::string reportCsv(const std::vector<CompareRow>& rows);
+/// One row a render: method, setting, CPU seconds (median, least, most), wall and prep
+/// seconds, errors (overall, by level, at every scale), foliage and per-tree biases; then the
+/// truth's own error against its check as the row `truth_check`.
+std::string reportCsv(const CompareRun& run);
+/// One row a method's tree: coverage and mean foliage luminance, its own and the truth's.
+std::string treesCsv(const CompareRun& run);
 std::string flickerCsv(const DollyFlicker& flicker);
 /// `scene` as rendered (its resolution).
 std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const ReportInfo& info);

@@ -6,6 +6,7 @@
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
+#include "pine/vdbtrace/tree_foliage.h"
 
 #include <functional>
 #include <optional>
@@ -17,6 +18,15 @@ namespace pine::vdbtrace {
 /// What is rendered. `forQuick(false)` is the full sweep, `forQuick(true)` a short one.
 struct CompareSettings {
     int truthSamples = 64;                        ///< geometry spp taken as the ground truth
+    /// The truth's shift of the sample sequence (GeometryOptions::sampleSeed); the sweep's is
+    /// 0. A truth sharing the sweep's first samples shares their noise and flatters them.
+    unsigned truthSeed = 1;
+    /// The truth is measured against a render of this many times its samples (another shift):
+    /// its own error, which the methods' must exceed for theirs to mean anything. 0: none.
+    int truthCheckFactor = 4;
+    /// Runs of each render; its time is the median run's by CPU seconds, with the least and
+    /// the most (a shared machine's load moves single runs by a third).
+    int repeat = 3;
     std::vector<int> geometrySamples{1, 4, 16};   ///< the geometry method's sweep
     std::vector<double> voxelSizes_cm{1.0, 0.5, 0.25};  ///< the reference's sweep
     int subpixels = 2;                            ///< reference rays per pixel along each axis
@@ -32,26 +42,53 @@ struct CompareSettings {
 struct CompareRow {
     std::string method, setting;  ///< as the report names them ("truth" among the methods)
     std::string renderer;         ///< the registered method that rendered it (methods.h)
-    double seconds = 0.0;
-    std::optional<double> prepSeconds;  ///< what the method prepared first (in `seconds`)
+    /// Process CPU seconds (all threads) of the median of the runs by CPU seconds, what the
+    /// method prepares first included; the least and the most of the runs; the median run's
+    /// wall seconds.
+    double seconds = 0.0, secondsMin = 0.0, secondsMax = 0.0, wallSeconds = 0.0;
+    int runs = 1;
+    std::optional<double> prepSeconds;  ///< wall seconds the method prepared first
     Image image;
     ImageErrors errors;
+    /// Each tree's foliage summed fragment by fragment (empty where the method knows no
+    /// trees), and its biases against the truth's (trees of at least 20 pixels).
+    std::vector<TreeFoliageSum> treeFoliage;
+    std::vector<TreeBias> treeBiases;
+    TreeBiasSummary trees;
+    /// All the foliage together against the truth's: coverage and mean luminance, ratio - 1
+    /// (unset where the method knows no trees).
+    std::optional<double> foliageCoverageBias, foliageLuminanceBias;
     bool truth = false;
     std::string stem() const { return method + "_" + setting; }
 };
 
+/// The truth against a render of truthCheckFactor times its samples.
+struct TruthCheck {
+    int samples = 0;
+    ImageErrors errors;
+};
+
 struct CompareRun {
     std::vector<CompareRow> rows;  ///< the truth first
+    std::optional<TruthCheck> truthCheck;
     double buildSeconds = 0.0;     ///< trees grown, BVH: not in rows
+    std::string load;              ///< the machine's load averages before and after the renders
 };
 
 /// A line of progress for a person (one per render).
 using CompareLog = std::function<void(const std::string&)>;
 
 /// Renders `scene` with every method and setting of `settings` and measures each against the
-/// truth. Throws what preparing and rendering throw.
+/// truth. Throws InputError where the methods cannot compute the same effects (checkEffects),
+/// and what preparing and rendering throw.
 CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& settings,
                          const CompareLog& log);
+
+/// Every method must compute the effects the scene names, or the comparison measures the
+/// effects, not the methods. Explicit needles and baked volumes shade through their own bough
+/// as through any other, so "shadows" and "self_shadowing" come together or not at all:
+/// throws InputError naming the methods that cannot otherwise.
+void checkEffects(const scenes::Effects& effects);
 
 /// A number for a person: `digits` significant digits.
 std::string formatNumber(double value, int digits = 4);
