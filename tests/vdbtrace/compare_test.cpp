@@ -3,8 +3,11 @@
 // samples), the report's errors at every scale and per-tree biases are what the EXRs it wrote
 // give, and the dolly's flicker is measured for the three methods.
 #include "pine/vdbtrace/compare.h"
+#include "pine/vdbtrace/error_budget.h"
 #include "pine/vdbtrace/flicker.h"
 #include "pine/vdbtrace/image.h"
+#include "pine/vdbtrace/methods.h"
+#include "pine/vdbtrace/traced_scene.h"
 
 #include <nlohmann/json.hpp>
 
@@ -87,7 +90,12 @@ TEST_F(Compare, ReportHasARowPerMethodAndSetting)
     ASSERT_EQ(status, 0);
     const Table rows = readCsv(dir / "out" / "report.csv");
     std::vector<std::string> names;
-    for (const auto& r : rows) names.push_back(r.at("method") + "_" + r.at("setting"));
+    for (const auto& r : rows) {
+        // The error budget's rows: TheErrorBudgetHasEachSwitchsRender.
+        if (r.at("method").rfind("budget:", 0) != 0) {
+            names.push_back(r.at("method") + "_" + r.at("setting"));
+        }
+    }
     std::vector<std::string> expected = {"truth_16spp",   "geometry_1spp",   "geometry_4spp",
                                          "reference_1cm", "reference_0.5cm", "multiscale_L1",
                                          "multiscale_L2", "multiscale_L3",   "multiscale_auto"};
@@ -202,7 +210,7 @@ TEST_F(Compare, ReportNumbersAreWhatTheWrittenImagesGive)
             EXPECT_GT(std::stod(r.at("rmse_k1")), 0.0);
             continue;
         }
-        if (r.at("method") == "truth") continue;
+        if (r.at("method") == "truth" || r.at("method").rfind("budget:", 0) == 0) continue;
         EXPECT_LE(std::stod(r.at("seconds_min")), std::stod(r.at("seconds"))) << name;
         EXPECT_LE(std::stod(r.at("seconds")), std::stod(r.at("seconds_max"))) << name;
         Metadata header;
@@ -259,6 +267,85 @@ TEST_F(Compare, ReportNumbersAreWhatTheWrittenImagesGive)
     }
     EXPECT_TRUE(sawCheck) << "no truth_check row";
     EXPECT_GE(checkedTrees, 6) << "geometry and multiscale rows should all carry their trees";
+}
+
+TEST_F(Compare, TheErrorBudgetHasEachSwitchsRender)
+{
+    ASSERT_EQ(status, 0);
+    const fs::path out = dir / "out";
+    const Table rows = readCsv(out / "report.csv");
+    std::vector<std::string> budget;
+    std::map<std::string, double> rmse;
+    for (const auto& r : rows) {
+        if (r.at("method").rfind("budget:", 0) != 0) continue;
+        budget.push_back(r.at("method") + " " + r.at("setting"));
+        rmse[r.at("setting")] = std::stod(r.at("rmse"));
+    }
+    scenes::Scene scene = scenes::parseScene(kFirScene, "fir.json");
+    std::vector<std::string> expected;
+    for (const BudgetSwitch& s : errorBudgetSwitches(scene.render.model)) {
+        expected.push_back("budget:" + s.method + " " + s.label);
+    }
+    EXPECT_EQ(budget, expected);
+    // One switch rendered here on its own (bark "line" at every level, as compare's
+    // multiscale auto), measured against the truth compare wrote.
+    scene.render.model.bark = "line";
+    const TracedScene traced = buildTracedScene(scene);
+    const RenderResult r = renderMethod("multiscale").render(traced, MethodSettings{}, {});
+    const Image truth = readExr(out / "truth_16spp.exr");
+    const double want = downsampledErrors(r.image, truth, 1).rmse;
+    EXPECT_NEAR(rmse.at("bark=line"), want, 1e-6 * want);
+    EXPECT_GT(std::abs(rmse.at("bark=line") - rmse.at("bough_law=linear")), 1e-6)
+        << "two switches rendered the same image";
+}
+
+TEST(ErrorBudget, EachSwitchMovesOneChoiceAndThePresetMovesAll)
+{
+    using scenes::ModelChoices;
+    const ModelChoices faithful = ModelChoices::faithful(), paper = ModelChoices::paper();
+    const auto differences = [](const ModelChoices& a, const ModelChoices& b) {
+        return int(a.boughLaw != b.boughLaw) + int(a.layerModel != b.layerModel) +
+               int(a.extinctionLaw != b.extinctionLaw) + int(a.shadowOrigin != b.shadowOrigin) +
+               int(a.levelBlend != b.levelBlend) + int(a.bark != b.bark) +
+               int(a.coneLevelMax != b.coneLevelMax) +
+               int(a.layerCorrelation != b.layerCorrelation);
+    };
+    const std::vector<BudgetSwitch> switches = errorBudgetSwitches(faithful);
+    ASSERT_FALSE(switches.empty());
+    int paperOnes = 0;
+    for (const BudgetSwitch& s : switches) {
+        if (s.label == "preset=paper") {
+            // Every multiscale choice the paper's; the reference's law left as the scene's.
+            ModelChoices expected = paper;
+            expected.extinctionLaw = faithful.extinctionLaw;
+            EXPECT_EQ(differences(s.model, expected), 0);
+            continue;
+        }
+        EXPECT_EQ(differences(s.model, faithful), 1) << s.label;
+        EXPECT_EQ(s.method, s.label.rfind("extinction_law", 0) == 0 ? "reference" : "multiscale")
+            << s.label;
+        // The paper's mark is right: the switched choice equals the paper's.
+        EXPECT_EQ(s.paper, differences(s.model, paper) == differences(faithful, paper) - 1)
+            << s.label;
+        paperOnes += s.paper;
+    }
+    // Every choice where the presets differ has its paper's switch (cone_level_max does not
+    // differ); the alternatives beyond the paper's too (bough_law corrected, shadow_origin bough,
+    // extinction_law poisson).
+    EXPECT_EQ(paperOnes, differences(faithful, paper));
+    EXPECT_EQ(switches.back().label, "preset=paper");
+    for (const char* other :
+         {"bough_law=corrected", "shadow_origin=bough", "extinction_law=poisson"}) {
+        EXPECT_TRUE(std::any_of(switches.begin(), switches.end(),
+                                [&](const BudgetSwitch& s) { return s.label == other; }))
+            << other;
+    }
+    // From the paper's choices: the faithful ones are the alternatives, no preset row.
+    for (const BudgetSwitch& s : errorBudgetSwitches(paper)) {
+        EXPECT_NE(s.label, "preset=paper");
+        EXPECT_FALSE(s.paper) << s.label;
+        EXPECT_EQ(differences(s.model, paper), 1) << s.label;
+    }
 }
 
 TEST(CompareRun, EffectsTheMethodsCannotShareAreRefused)

@@ -86,6 +86,9 @@ CompareRun runCompare(const CompareOptions& options)
     io::writeTextAtomically(dir / "report.md", reportMd(run, scene, info));
 
     std::string summary = std::to_string(run.rows.size()) + " renders";
+    if (!run.budget.empty()) {
+        summary += ", " + std::to_string(run.budget.size()) + " for the error budget";
+    }
     if (options.flicker) summary += " and " + std::to_string(st.frames) + " dolly frames x 3";
     summary += " in " +
                formatNumber(std::chrono::duration<double>(Clock::now() - start).count(), 3) +

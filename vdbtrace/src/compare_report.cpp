@@ -19,6 +19,12 @@ bool hasLevels(const CompareRow& row)
 // The scale at which "equal error" is stated besides per pixel (issue: a fair comparison).
 constexpr int kNamedScale = 4;
 
+double rmseAt(const CompareRow& row, int k)
+{
+    const ImageErrors::AtScale* a = row.errors.atScale(k);
+    return a ? a->rmse : row.errors.rmse;
+}
+
 std::string percent(double fraction)
 {
     return formatNumber(100.0 * fraction, 3) + "%";
@@ -104,6 +110,76 @@ std::string truthSection(const CompareRun& run, const CompareSettings& st)
     return s.str();
 }
 
+// "value (change)" of a switched row against its own.
+std::string withChange(double value, double own, bool asPercent)
+{
+    const double d = value - own;
+    if (asPercent) {
+        return percent(value) + " (" + (d >= 0.0 ? "+" : "") + formatNumber(100.0 * d, 3) +
+               " pts)";
+    }
+    return formatNumber(value) + " (" + (d >= 0.0 ? "+" : "") + formatNumber(d, 3) + ")";
+}
+
+std::string budgetLine(const std::string& what, const std::string& paper,
+                       const std::string& method, const CompareRow& row, const CompareRow& own)
+{
+    std::ostringstream s;
+    s << "| " << what << " | " << paper << " | " << method << " | "
+      << withChange(row.errors.rmse, own.errors.rmse, false) << " | "
+      << withChange(rmseAt(row, kNamedScale), rmseAt(own, kNamedScale), false) << " | ";
+    if (row.trees.trees && own.trees.trees) {
+        s << withChange(row.trees.luminance.median, own.trees.luminance.median, true) << " | "
+          << row.trees.luminance.beyond << " (" << own.trees.luminance.beyond << ") | ";
+    } else {
+        s << " | | ";
+    }
+    if (row.foliageLuminanceBias && own.foliageLuminanceBias) {
+        s << withChange(*row.foliageLuminanceBias, *own.foliageLuminanceBias, true);
+    }
+    const double saved = own.seconds - row.seconds;
+    s << " | " << formatNumber(row.seconds, 3) << " (" << (saved >= 0.0 ? "saves " : "costs ")
+      << formatNumber(100.0 * std::abs(saved) / std::max(own.seconds, 1e-12), 4) << "%) |\n";
+    return s.str();
+}
+
+std::string budgetSection(const CompareRun& run)
+{
+    std::ostringstream s;
+    const CompareRow* ownMultiscale = findRow(run.rows, "multiscale", "auto");
+    const CompareRow* finest = nullptr;
+    for (const CompareRow& r : run.rows) {
+        if (r.method == "reference" &&
+            (!finest || std::stod(r.setting) < std::stod(finest->setting))) {
+            finest = &r;
+        }
+    }
+    if (run.budget.empty() && !finest) return "No error budget was rendered.\n";
+    s << "Each approximation switched alone from the scene's own choice (`error_budget.h`: "
+         "every alternative of every model choice, the paper's marked), and every choice the "
+         "paper's at once, against the render with the scene's own choices (multiscale auto; "
+         "the reference at its finest voxels): its error per pixel and at k = "
+      << kNamedScale
+      << ", its per-tree bias (median, trees beyond 3%), the bias of all its foliage, and "
+         "its CPU time, each with its change (a negative added error: the switch is nearer "
+         "the truth). The reference's voxel size is the last rows'.\n\n"
+         "| approximation | the paper's | method | RMSE (added) | RMSE k=4 (added) | "
+         "per-tree luminance median | trees > 3% (own) | all foliage luminance | CPU s |\n"
+         "|---|---|---|---|---|---|---|---|---|\n";
+    for (const BudgetRow& b : run.budget) {
+        const CompareRow* own = b.what.method == "reference" ? finest : ownMultiscale;
+        if (!own) continue;
+        s << budgetLine(b.what.label, b.what.paper ? "yes" : "", b.what.method, b.row, *own);
+    }
+    for (const CompareRow& r : run.rows) {
+        if (finest && r.method == "reference" && &r != finest) {
+            s << budgetLine("voxel size " + r.setting + " (not " + finest->setting + ")", "",
+                            "reference", r, *finest);
+        }
+    }
+    return s.str();
+}
+
 std::string treeSection(const CompareRun& run)
 {
     std::ostringstream s;
@@ -136,12 +212,6 @@ std::string treeSection(const CompareRun& run)
           << c.worstTree << ") | " << c.beyond << " |\n";
     }
     return s.str();
-}
-
-double rmseAt(const CompareRow& row, int k)
-{
-    const ImageErrors::AtScale* a = row.errors.atScale(k);
-    return a ? a->rmse : row.errors.rmse;
 }
 
 // The fastest geometry render (not the truth) whose RMSE at scale k is at most `rmse`.
@@ -273,7 +343,11 @@ std::string reportCsv(const CompareRun& run)
             if (const ImageErrors::AtScale* a = e.atScale(k)) s << a->mae;
         }
     };
-    for (const CompareRow& r : run.rows) {
+    std::vector<const CompareRow*> rows;
+    for (const CompareRow& r : run.rows) rows.push_back(&r);
+    for (const BudgetRow& b : run.budget) rows.push_back(&b.row);
+    for (const CompareRow* row : rows) {
+        const CompareRow& r = *row;
         s << r.method << ',' << r.setting << ',' << r.seconds << ',' << r.secondsMin << ','
           << r.secondsMax << ',' << r.wallSeconds << ',' << r.runs << ',';
         if (r.prepSeconds) s << *r.prepSeconds;
@@ -314,7 +388,11 @@ std::string treesCsv(const CompareRun& run)
     s << "method,setting,tree,coverage_px,coverage_px_truth,coverage_bias,luminance,"
          "luminance_truth,luminance_bias\n"
       << std::setprecision(9);
-    for (const CompareRow& r : run.rows) {
+    std::vector<const CompareRow*> rows;
+    for (const CompareRow& r : run.rows) rows.push_back(&r);
+    for (const BudgetRow& b : run.budget) rows.push_back(&b.row);
+    for (const CompareRow* row : rows) {
+        const CompareRow& r = *row;
         for (const TreeBias& t : r.treeBiases) {
             s << r.method << ',' << r.setting << ',' << t.truth.tree << ',' << t.image.coverage
               << ',' << t.truth.coverage << ',' << t.coverageBias << ',' << t.image.luminance << ','
@@ -438,6 +516,7 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
     s << "## Error at every scale\n\n" << scaleSection(run, c.plotted) << '\n';
     s << "## Speed at equal error\n\n" << speedSection(rows) << '\n';
     s << "## Bias per tree\n\n" << treeSection(run) << '\n';
+    s << "## Error budget\n\n" << budgetSection(run) << '\n';
     s << "## Where the linear law's error shows\n\n" << levelSection(rows) << '\n';
     s << "## Images\n\nPreviews over the scene's background; error maps of the luminance error "
          "from 0 (black) to "

@@ -2,6 +2,7 @@
 
 #include "pine/support/input_error.h"
 #include "pine/support/process_clock.h"
+#include "pine/vdbtrace/error_budget.h"
 #include "pine/vdbtrace/methods.h"
 
 #include <algorithm>
@@ -137,7 +138,7 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
         return *own;
     };
 
-    const auto measure = [&](CompareRow row) {
+    const auto judge = [&](CompareRow& row) {
         const CompareRow& truth = run.rows.empty() ? row : run.rows.front();
         row.errors = compareImages(row.image, truth.image);
         measureTrees(row, truth);
@@ -158,6 +159,9 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
             }
             log(line);
         }
+    };
+    const auto measure = [&](CompareRow row) {
+        judge(row);
         run.rows.push_back(std::move(row));
     };
     MethodSettings s;
@@ -194,6 +198,31 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
         s.multiscale.forceLevel = level;
         measure(render(builtAgain, "multiscale", "multiscale",
                        level ? "L" + std::to_string(level) : "auto", s, st.repeat));
+    }
+    if (st.budget) {
+        // Each switch against the row rendered with the scene's own choices: multiscale
+        // (auto), and the reference at the finest voxel size.
+        const auto finest = std::min_element(st.voxelSizes_cm.begin(), st.voxelSizes_cm.end());
+        const bool automatic = std::find(st.levels.begin(), st.levels.end(), 0) != st.levels.end();
+        for (const BudgetSwitch& what : errorBudgetSwitches(scene.render.model)) {
+            const bool reference = what.method == "reference";
+            if (reference ? finest == st.voxelSizes_cm.end() : !automatic) continue;
+            scenes::Scene switched = scene;
+            switched.render.model = what.model;
+            std::optional<TracedScene> switchedTraced;
+            const auto sceneFor = [&](int) -> const TracedScene& {
+                switchedTraced.reset();
+                switchedTraced.emplace(buildTracedScene(switched));
+                return *switchedTraced;
+            };
+            s.multiscale.forceLevel = 0;
+            if (reference) s.voxelSize_cm = *finest;
+            CompareRow row = render(sceneFor, what.method, "budget:" + what.method, what.label, s,
+                                    st.repeat);
+            judge(row);
+            row.image = Image();  // only its numbers are reported
+            run.budget.push_back({what, std::move(row)});
+        }
     }
     run.load += " before; " + loadAverages() + " after";
     return run;

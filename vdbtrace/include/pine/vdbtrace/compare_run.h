@@ -5,6 +5,7 @@
 
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/image.h"
+#include "pine/vdbtrace/error_budget.h"
 #include "pine/vdbtrace/image_diff.h"
 #include "pine/vdbtrace/tree_foliage.h"
 
@@ -27,6 +28,9 @@ struct CompareSettings {
     /// Runs of each render; its time is the median run's by CPU seconds, with the least and
     /// the most (a shared machine's load moves single runs by a third).
     int repeat = 3;
+    /// Also render the error budget (error_budget.h): every alternative of every model
+    /// choice alone, multiscale (auto) or the reference at the finest voxel size.
+    bool budget = true;
     std::vector<int> geometrySamples{1, 4, 16};   ///< the geometry method's sweep
     std::vector<double> voxelSizes_cm{1.0, 0.5, 0.25};  ///< the reference's sweep
     int subpixels = 2;                            ///< reference rays per pixel along each axis
@@ -68,9 +72,16 @@ struct TruthCheck {
     ImageErrors errors;
 };
 
+/// One approximation of the error budget and its render (its image dropped once measured).
+struct BudgetRow {
+    BudgetSwitch what;
+    CompareRow row;
+};
+
 struct CompareRun {
     std::vector<CompareRow> rows;  ///< the truth first
     std::optional<TruthCheck> truthCheck;
+    std::vector<BudgetRow> budget;
     double buildSeconds = 0.0;     ///< trees grown, BVH: not in rows
     std::string load;              ///< the machine's load averages before and after the renders
 };
