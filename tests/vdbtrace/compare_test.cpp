@@ -336,9 +336,9 @@ TEST(ErrorBudget, EachSwitchMovesOneChoiceAndThePresetMovesAll)
     EXPECT_EQ(switches.back().label, "preset=paper");
     for (const char* other :
          {"bough_law=corrected", "shadow_origin=bough", "extinction_law=poisson"}) {
-        EXPECT_TRUE(std::any_of(switches.begin(), switches.end(),
-                                [&](const BudgetSwitch& s) { return s.label == other; }))
-            << other;
+        EXPECT_TRUE(std::any_of(switches.begin(), switches.end(), [&](const BudgetSwitch& s) {
+            return s.label == other;
+        })) << other;
     }
     // From the paper's choices: the faithful ones are the alternatives, no preset row.
     for (const BudgetSwitch& s : errorBudgetSwitches(paper)) {

@@ -115,14 +115,13 @@ std::string withChange(double value, double own, bool asPercent)
 {
     const double d = value - own;
     if (asPercent) {
-        return percent(value) + " (" + (d >= 0.0 ? "+" : "") + formatNumber(100.0 * d, 3) +
-               " pts)";
+        return percent(value) + " (" + (d >= 0.0 ? "+" : "") + formatNumber(100.0 * d, 3) + " pts)";
     }
     return formatNumber(value) + " (" + (d >= 0.0 ? "+" : "") + formatNumber(d, 3) + ")";
 }
 
-std::string budgetLine(const std::string& what, const std::string& paper,
-                       const std::string& method, const CompareRow& row, const CompareRow& own)
+std::string budgetLine(const std::string& what, const std::string& paper, const std::string& method,
+                       const CompareRow& row, const CompareRow& own)
 {
     std::ostringstream s;
     s << "| " << what << " | " << paper << " | " << method << " | "

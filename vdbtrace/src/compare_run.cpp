@@ -217,8 +217,8 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
             };
             s.multiscale.forceLevel = 0;
             if (reference) s.voxelSize_cm = *finest;
-            CompareRow row = render(sceneFor, what.method, "budget:" + what.method, what.label, s,
-                                    st.repeat);
+            CompareRow row =
+                render(sceneFor, what.method, "budget:" + what.method, what.label, s, st.repeat);
             judge(row);
             row.image = Image();  // only its numbers are reported
             run.budget.push_back({what, std::move(row)});

@@ -46,8 +46,7 @@ std::vector<BudgetSwitch> errorBudgetSwitches(const ModelChoices& scene)
         {"extinction_law", "reference", bake::extinctionLawNames, &ModelChoices::extinctionLaw},
         {"shadow_origin", "multiscale", shadowOriginNames, &ModelChoices::shadowOrigin},
         {"bark", "multiscale", barkNames, &ModelChoices::bark},
-        {"layer_correlation", "multiscale", layerCorrelationNames,
-         &ModelChoices::layerCorrelation},
+        {"layer_correlation", "multiscale", layerCorrelationNames, &ModelChoices::layerCorrelation},
     };
     const NumberChoice numbers[] = {{"level_blend", &ModelChoices::levelBlend},
                                     {"cone_level_max", &ModelChoices::coneLevelMax}};

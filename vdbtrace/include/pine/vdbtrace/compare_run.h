@@ -4,8 +4,8 @@
 #pragma once
 
 #include "pine/scenes/scene.h"
-#include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/error_budget.h"
+#include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
 #include "pine/vdbtrace/tree_foliage.h"
 
