@@ -275,7 +275,8 @@ std::string levelSection(const std::vector<CompareRow>& rows)
     const CompareRow* ms = findRow(rows, "multiscale", "auto");
     if (!ms || !hasLevels(*ms)) return "No multiscale level AOV: nothing to split.\n";
     const auto& l = ms->errors.byLevel;
-    const char* names[4] = {"no foliage", "needle", "cone", "bough"};
+    const char* names[4] = {"no foliage (ground and its shadows, sky, branches)", "needle",
+                            "cone", "bough"};
     // Each level's share of the squared error says where the image's RMSE comes from.
     double total = 0.0;
     for (int k = 0; k < 4; ++k) total += double(l[k].pixels) * l[k].rmse * l[k].rmse;
@@ -290,7 +291,7 @@ std::string levelSection(const std::vector<CompareRow>& rows)
           << (l[k].relativePixels ? formatNumber(l[k].meanRelative) : "-") << " | "
           << formatNumber(100.0 * share, 3) << "% |\n";
     }
-    // Needle and cone levels pooled: the foliage shaded without the linear law.
+    // Needle and cone levels pooled: the foliage shaded without a bough law.
     const double n12 = double(l[1].pixels + l[2].pixels);
     const double rest = n12 > 0.0 ? std::sqrt((double(l[1].pixels) * l[1].rmse * l[1].rmse +
                                                double(l[2].pixels) * l[2].rmse * l[2].rmse) /
@@ -298,13 +299,14 @@ std::string levelSection(const std::vector<CompareRow>& rows)
                                   : 0.0;
     s << '\n';
     if (l[3].pixels == 0) {
-        s << "No pixel is shaded at the bough level in this view: the linear law does not show "
+        s << "No pixel is shaded at the bough level in this view: the bough law does not show "
              "here.\n";
     } else if (n12 == 0.0) {
         s << "Every foliage pixel is at the bough level: RMSE " << formatNumber(l[3].rmse)
           << "; nothing to set it against.\n";
     } else {
-        s << "The bough level (section 6.6's linear law) has RMSE " << formatNumber(l[3].rmse)
+        s << "The bough level (the bough law, `render.bough_law`) has RMSE "
+          << formatNumber(l[3].rmse)
           << " against " << formatNumber(rest) << " for the needle and cone levels pooled ("
           << formatNumber(l[3].rmse / std::max(rest, 1e-12), 3) << " times).";
         const CompareRow* l3 = findRow(rows, "multiscale", "L3");
@@ -516,7 +518,7 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
     s << "## Speed at equal error\n\n" << speedSection(rows) << '\n';
     s << "## Bias per tree\n\n" << treeSection(run) << '\n';
     s << "## Error budget\n\n" << budgetSection(run) << '\n';
-    s << "## Where the linear law's error shows\n\n" << levelSection(rows) << '\n';
+    s << "## Where the bough law's error shows\n\n" << levelSection(rows) << '\n';
     s << "## Images\n\nPreviews over the scene's background; error maps of the luminance error "
          "from 0 (black) to "
       << formatNumber(c.errorScale) << " (white), the 99th percentile of all errors, one scale for "

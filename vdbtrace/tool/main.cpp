@@ -794,6 +794,22 @@ std::string machineDescription()
            std::to_string(tbb::this_task_arena::max_concurrency()) + " threads";
 }
 
+// Runs of a timed render: odd, so that the median is one run.
+CLI::Validator oddRuns()
+{
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            try {
+                const int k = std::stoi(text);
+                if (k >= 1 && k <= 15 && k % 2 == 1) return {};
+            } catch (const std::exception&) {
+            }
+            return "must be an odd number from 1 to 15 (the median is one run), got '" + text +
+                   "'";
+        },
+        "odd in [1, 15]");
+}
+
 bool plotCompare(const fs::path& dir)
 {
     return tool::runPlotScript(tool::plotScript("plot_compare.py"), dir) &&
@@ -1004,17 +1020,7 @@ int main(int argc, char** argv)
         ->add_option("--repeat", benchRepeats,
                      "Runs of each render (odd); the times are the median by CPU seconds, "
                      "with the least and the most")
-        ->check(CLI::Validator(
-            [](std::string& text) -> std::string {
-                try {
-                    const int k = std::stoi(text);
-                    if (k >= 1 && k <= 15 && k % 2 == 1) return {};
-                } catch (const std::exception&) {
-                }
-                return "must be an odd number from 1 to 15 (the median is one run), got '" +
-                       text + "'";
-            },
-            "odd in [1, 15]"))
+        ->check(oddRuns())
         ->capture_default_str();
     benchCmd->add_option("--json", benchJson, "Also write every number as JSON");
     double benchLawCacheMiB = 0.0;  // 0: keep every profile
@@ -1067,7 +1073,7 @@ int main(int argc, char** argv)
         ->check(CLI::NonNegativeNumber);
 
     vdbtrace::CompareOptions compare;
-    bool quick = false, noPlot = false;
+    bool quick = false, noPlot = false, noBudget = false;
     std::string resolution;
     auto* compareCmd =
         app.add_subcommand("compare",
@@ -1083,6 +1089,19 @@ int main(int argc, char** argv)
     addResolution(*compareCmd, resolution, "WxH instead of the camera's (same view)", "64x48");
     compareCmd->add_flag("--no-plot", noPlot,
                          "Skip error_vs_time.png and error_vs_scale.png (matplotlib)");
+    int truthSamples = 0, compareRepeat = 0;
+    compareCmd
+        ->add_option("--truth-samples", truthSamples,
+                     "Samples per pixel of the ground truth (default 64, 16 with --quick); it "
+                     "is checked against 4 times as many")
+        ->check(CLI::Range(1, 4096));
+    compareCmd
+        ->add_option("--repeat", compareRepeat,
+                     "Runs of each render, timed as the median by CPU seconds (odd; default 3, "
+                     "1 with --quick)")
+        ->check(oddRuns());
+    compareCmd->add_flag("--no-budget", noBudget,
+                         "Skip the error budget (each model choice's alternatives alone)");
     compareCmd->add_flag("--self-shadowing", compare.addSelfShadowing,
                          "Add self_shadowing to the scene's effects: the explicit needles "
                          "always self-shadow, so a scene with shadows alone is refused "
@@ -1110,6 +1129,9 @@ int main(int argc, char** argv)
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
         if (*compareCmd) {
             compare.settings = vdbtrace::CompareSettings::forQuick(quick);
+            if (truthSamples > 0) compare.settings.truthSamples = truthSamples;
+            if (compareRepeat > 0) compare.settings.repeat = compareRepeat;
+            compare.settings.budget = !noBudget;
             compare.maxMemoryBytes = bake::memoryLimit(maxMemoryGiB);
             compare.machine = machineDescription();
             compare.model = [&model](scenes::ModelChoices& m) { model.apply(m); };
