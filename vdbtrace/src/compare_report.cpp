@@ -521,7 +521,8 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
     }
     s << ". It reads colour and contrast; its luminance test (OpenImageIO 2.4) tells no grey "
          "texture apart from a flat patch in our checks, so an error of brightness alone can "
-         "escape it: read it beside the RMSE, not for it.\n\nEvery number of this report is in [report.csv](report.csv) (the truth's own error "
+         "escape it: read it beside the RMSE, not for it.\n\nEvery number of this report is in "
+         "[report.csv](report.csv) (the truth's own error "
          "as the row `truth_check`), each tree's in [trees.csv](trees.csv).\n\n";
     if (c.plotted) s << "![RMSE against CPU seconds](error_vs_time.png)\n\n";
     s << "## Error at every scale\n\n" << scaleSection(run, c.plotted) << '\n';
