@@ -46,8 +46,9 @@ CompareRun runCompare(const CompareOptions& options)
     }
     const CompareSettings& st = options.settings;
     if (options.maxMemoryBytes > 0.0) {
-        const std::size_t images = 1 + st.geometrySamples.size() + st.voxelSizes_cm.size() +
-                                   st.levels.size();
+        // The truth's check and a budget row's image are held while they are measured.
+        const std::size_t images =
+            1 + st.geometrySamples.size() + st.voxelSizes_cm.size() + st.levels.size() + 1;
         const double smallest =
             st.voxelSizes_cm.empty()
                 ? 1.0
