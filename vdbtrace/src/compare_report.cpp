@@ -330,7 +330,7 @@ std::string reportCsv(const CompareRun& run)
          "mean_relative,max_absolute,rmse_needle,rmse_cone,rmse_bough";
     for (const int k : kErrorScales) s << ",rmse_k" << k;
     for (const int k : kErrorScales) s << ",mae_k" << k;
-    s << ",perceptual_yee,foliage_coverage_bias,foliage_luminance_bias,trees,"
+    s << ",foliage_coverage_bias,foliage_luminance_bias,trees,"
          "tree_luminance_median,"
          "tree_luminance_worst,tree_luminance_worst_tree,trees_luminance_beyond_3pct,"
          "tree_coverage_median,tree_coverage_worst,tree_coverage_worst_tree,"
@@ -360,7 +360,7 @@ std::string reportCsv(const CompareRun& run)
             if (hasLevels(r) && r.errors.byLevel[level].pixels) s << r.errors.byLevel[level].rmse;
         }
         errorColumns(r.errors);
-        s << ',' << r.perceptual << ',';
+        s << ',';
         if (r.foliageCoverageBias) s << *r.foliageCoverageBias;
         s << ',';
         if (r.foliageLuminanceBias) s << *r.foliageLuminanceBias;
@@ -380,7 +380,7 @@ std::string reportCsv(const CompareRun& run)
         s << "truth_check," << run.truthCheck->samples << "spp,,,,,,," << e.rmse << ','
           << e.meanRelative << ',' << e.maxAbsolute << ",,,";
         errorColumns(e);
-        s << ',' << run.truthCheck->perceptual << ",,,,,,,,,,,\n";
+        s << ",,,,,,,,,,,\n";
     }
     return s.str();
 }
@@ -490,11 +490,11 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
     s << "## Error against time\n\n"
          "Errors: linear luminance of premultiplied RGB against the ground truth "
          "(`compareImages`): RMSE over all pixels, mean relative over pixels brighter than 1% "
-         "of the truth's mean, maximum, the share of pixels a perceptual metric tells apart, "
-         "and for multiscale the RMSE over the pixels of each level.\n\n";
+         "of the truth's mean, maximum, and for multiscale the RMSE over the pixels of each "
+         "level.\n\n";
     s << "| method | setting | CPU s | [least, most] | wall s | prep s | RMSE | mean relative | "
-         "max | Yee: pixels told apart | RMSE needle | RMSE cone | RMSE bough |\n"
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "max | RMSE needle | RMSE cone | RMSE bough |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const CompareRow& r : rows) {
         s << "| " << r.method << " | " << r.setting << " | " << formatNumber(r.seconds, 3) << " | ";
         if (r.runs > 1) {
@@ -504,7 +504,7 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
         s << " | " << formatNumber(r.wallSeconds, 3) << " | "
           << (r.prepSeconds ? formatNumber(*r.prepSeconds, 3) : "") << " | "
           << formatNumber(r.errors.rmse) << " | " << formatNumber(r.errors.meanRelative) << " | "
-          << formatNumber(r.errors.maxAbsolute) << " | " << (r.truth ? "" : percent(r.perceptual));
+          << formatNumber(r.errors.maxAbsolute);
         for (int level = 1; level <= 3; ++level) {
             s << " | ";
             if (hasLevels(r) && r.errors.byLevel[level].pixels) {
@@ -513,16 +513,7 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
         }
         s << " |\n";
     }
-    s << "\nYee: the share of pixels that Yee's perceptual metric (JGT 2004, OpenImageIO's "
-         "`compare_Yee`) tells apart from the truth's, both over the scene's background, on "
-         "a display of 100 cd/m^2 spanning "
-      << formatNumber(kPerceptualFov_deg) << " degrees";
-    if (run.truthCheck) {
-        s << " (the truth against its check: " << percent(run.truthCheck->perceptual) << ")";
-    }
-    s << ". It reads colour and contrast; its luminance test (OpenImageIO 2.4) tells no grey "
-         "texture apart from a flat patch in our checks, so an error of brightness alone can "
-         "escape it: read it beside the RMSE, not for it.\n\nEvery number of this report is in "
+    s << "\nEvery number of this report is in "
          "[report.csv](report.csv) (the truth's own error "
          "as the row `truth_check`), each tree's in [trees.csv](trees.csv).\n\n";
     if (c.plotted) s << "![RMSE against CPU seconds](error_vs_time.png)\n\n";

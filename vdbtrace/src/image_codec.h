@@ -58,11 +58,6 @@ public:
     /// calls it), every channel as float; refuses another format or a deep or 3D image.
     virtual Decoded read(const std::filesystem::path& file, const char* format,
                          const char* formatName) const = 0;
-    /// The pixels of two linear RGB images (interleaved, 3 floats a pixel, `width` x `height`
-    /// each) that Yee's perceptual metric (OpenImageIO's compare_Yee: a display of 100 cd/m^2
-    /// seen over `fov_deg`) tells apart.
-    virtual std::size_t perceptuallyDifferent(const float* a, const float* b, int width, int height,
-                                              double fov_deg) const = 0;
 };
 
 /// The module's codec, loaded on first use, once, from any thread. Looked for beside the

@@ -1,9 +1,5 @@
 #include "pine/vdbtrace/image_diff.h"
 
-#include "pine/vdbtrace/preview.h"
-
-#include "image_codec.h"
-
 #include <algorithm>
 #include <cmath>
 
@@ -137,34 +133,6 @@ ImageErrors compareImages(const Image& image, const Image& reference)
     e.rmse = std::sqrt(sumSq / double(std::max<std::size_t>(n, 1)));
     e.meanRelative = e.relativePixels ? sumRelative / double(e.relativePixels) : 0.0;
     return e;
-}
-
-double perceptualDifference(const Image& image, const Image& reference,
-                            const scenes::Vec3& background, double fov_deg)
-{
-    if (image.width != reference.width || image.height != reference.height) {
-        throw ImageError("images differ in size: " + std::to_string(image.width) + "x" +
-                         std::to_string(image.height) + " against " +
-                         std::to_string(reference.width) + "x" + std::to_string(reference.height));
-    }
-    const std::size_t n = std::size_t(image.width) * image.height;
-    if (n == 0) return 0.0;
-    const auto over = [&](const Image& from) {  // as the preview shows it, RGB alone
-        const Image flat = overBackground(from, background);
-        std::vector<float> rgb(3 * n);
-        for (std::size_t i = 0; i < n; ++i) {
-            for (int c = 0; c < 3; ++c) rgb[3 * i + c] = flat.rgba[4 * i + c];
-        }
-        return rgb;
-    };
-    const std::vector<float> a = over(image), b = over(reference);
-    try {
-        return double(codec::imageCodec().perceptuallyDifferent(a.data(), b.data(), image.width,
-                                                                image.height, fov_deg)) /
-               double(n);
-    } catch (const std::runtime_error& e) {
-        throw ImageError(e.what());
-    }
 }
 
 void writeErrorPng(const ImageErrors& errors, double scale, const std::filesystem::path& path)

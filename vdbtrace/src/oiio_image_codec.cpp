@@ -3,8 +3,6 @@
 #include "image_codec.h"
 
 #include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -45,18 +43,6 @@ OIIO::ImageSpec specOf(const Header& header)
 
 class OiioCodec final : public Codec {
 public:
-    std::size_t perceptuallyDifferent(const float* a, const float* b, int width, int height,
-                                      double fov_deg) const override
-    {
-        const OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::FLOAT);
-        // Wrapped, not copied; compare_Yee only reads them.
-        const OIIO::ImageBuf A(spec, const_cast<float*>(a)), B(spec, const_cast<float*>(b));
-        OIIO::ImageBufAlgo::CompareResults result{};
-        const int failed = OIIO::ImageBufAlgo::compare_Yee(A, B, result, 100.0f, float(fov_deg));
-        if (result.error) fail("perceptual comparison failed: " + OIIO::geterror());
-        return std::size_t(std::max(failed, 0));
-    }
-
     bool write(const char* format, const Header& header, const void* pixels,
                const std::filesystem::path& file,
                std::vector<unsigned char>& memory) const override

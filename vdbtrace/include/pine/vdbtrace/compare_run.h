@@ -54,9 +54,6 @@ struct CompareRow {
     std::optional<double> prepSeconds;  ///< wall seconds the method prepared first
     Image image;
     ImageErrors errors;
-    /// The fraction of pixels Yee's perceptual metric tells apart from the truth's, both over
-    /// the scene's background on a display spanning kPerceptualFov_deg (perceptualDifference).
-    double perceptual = 0.0;
     /// Each tree's foliage summed fragment by fragment (empty where the method knows no
     /// trees), and its biases against the truth's (trees of at least 20 pixels).
     std::vector<TreeFoliageSum> treeFoliage;
@@ -73,12 +70,7 @@ struct CompareRow {
 struct TruthCheck {
     int samples = 0;
     ImageErrors errors;
-    double perceptual = 0.0;
 };
-
-/// The field of view the perceptual metric assumes the display spans: OpenImageIO's and
-/// perceptualdiff's default, about a 640-pixel image on a desktop screen at arm's length.
-inline constexpr double kPerceptualFov_deg = 45.0;
 
 /// One approximation of the error budget and its render (its image dropped once measured).
 struct BudgetRow {

@@ -1,7 +1,6 @@
 // `vdbtrace diff`: how far an image is from a reference, per pixel and overall.
 #pragma once
 
-#include "pine/scenes/scene.h"
 #include "pine/vdbtrace/image.h"
 
 #include <nlohmann/json.hpp>
@@ -46,13 +45,6 @@ inline constexpr int kErrorScales[] = {1, 2, 4, 8, 16};
 
 /// Throws ImageError if the sizes differ.
 ImageErrors compareImages(const Image& image, const Image& reference);
-
-/// The fraction of pixels Yee's perceptual metric (A Perceptual Metric for Production Testing,
-/// JGT 2004; OpenImageIO's compare_Yee) tells apart, both images composited over `background`
-/// as a viewer sees them, on a display of 100 cd/m^2 spanning `fov_deg` of the visual field.
-/// Loads OpenImageIO (image_io.h). Throws ImageError if the sizes differ or the module fails.
-double perceptualDifference(const Image& image, const Image& reference,
-                            const scenes::Vec3& background, double fov_deg);
 
 /// False colours (black - blue - green - yellow - white) of the luminance error from 0 to
 /// `scale`, with a colour bar along the bottom (0 at the left, `scale` at the right; the scale is
