@@ -13,6 +13,10 @@ and writes, each atomically (via NAME.tmp.png):
 - DIR/error_vs_scale.png: RMSE after box-downsampling both images by k, over k,
   one line per render, and the truth's own error against its check (dotted).
   Noise falls as 1/k (the dashed slope), a bias stays flat.
+- DIR/tree_bias.png, where DIR/trees.csv has rows: each tree's foliage
+  luminance bias against the truth over the truth's coverage of it in pixels,
+  one marker per render of the sweep (the error budget's left out), the +-3%
+  band shaded.
 """
 import csv
 import os
@@ -101,12 +105,45 @@ def plot_scales(rows, directory):
     save(fig, directory, "error_vs_scale.png")
 
 
+def plot_trees(directory):
+    path = os.path.join(directory, "trees.csv")
+    if not os.path.exists(path):
+        return
+    with open(path, newline="") as fh:
+        trees = [r for r in csv.DictReader(fh)
+                 if r["method"] != "truth" and not r["method"].startswith("budget:")]
+    if not trees:
+        return
+    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    ax.axhspan(-3, 3, color="grey", alpha=0.15, label="within 3%")
+    shades = {}
+    for key in dict.fromkeys((r["method"], r["setting"]) for r in trees):
+        method, setting = key
+        points = [(float(r["coverage_px_truth"]), 100.0 * float(r["luminance_bias"]))
+                  for r in trees if (r["method"], r["setting"]) == key]
+        colour, marker, _ = STYLE.get(method, ("black", "x", method))
+        shade = shades.get(method, 0)
+        shades[method] = shade + 1
+        xs, ys = zip(*points)
+        ax.scatter(xs, ys, color=colour, marker=marker, s=14,
+                   alpha=max(0.3, 1.0 - 0.25 * shade), label=f"{method} {setting}")
+    ax.set_xscale("log")
+    ax.set_xlabel("the tree's foliage in the truth (pixels)")
+    ax.set_ylabel("foliage luminance against the truth (%)")
+    ax.set_title("Bias per tree")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    save(fig, directory, "tree_bias.png")
+
+
 def main():
     if len(sys.argv) != 2:
         fail("usage: plot_compare.py DIR")
     directory = sys.argv[1]
     rows = load(directory)
     plot_scales(rows, directory)
+    plot_trees(directory)
     fig, ax = plt.subplots(figsize=(7.5, 5.0))
     for method, (colour, marker, label) in STYLE.items():
         points = [(float(r["seconds"]), float(r["rmse"]), r["setting"])

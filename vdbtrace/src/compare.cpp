@@ -70,6 +70,7 @@ CompareRun runCompare(const CompareOptions& options)
     io::writeTextAtomically(dir / "trees.csv", treesCsv(run));
     if (options.plot) {
         info.plotted = options.plot(dir);
+        info.treePlot = info.plotted && std::filesystem::exists(dir / "tree_bias.png");
         if (!info.plotted) {
             (options.warn ? options.warn : log)(
                 "warning: plotting failed (report.csv has the data)");

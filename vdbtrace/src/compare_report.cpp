@@ -180,7 +180,7 @@ std::string budgetSection(const CompareRun& run)
     return s.str();
 }
 
-std::string treeSection(const CompareRun& run)
+std::string treeSection(const CompareRun& run, bool treePlot)
 {
     std::ostringstream s;
     const CompareRow& truth = run.rows.front();
@@ -210,6 +210,24 @@ std::string treeSection(const CompareRun& run)
           << percent(l.median) << " | " << percent(l.worst) << " (tree " << l.worstTree << ") | "
           << l.beyond << " | " << percent(c.median) << " | " << percent(c.worst) << " (tree "
           << c.worstTree << ") | " << c.beyond << " |\n";
+    }
+    if (treePlot) s << "\n![Bias per tree](tree_bias.png)\n";
+    // The trees a reader should look at first: multiscale's farthest from the truth.
+    const CompareRow* ms = findRow(run.rows, "multiscale", "auto");
+    if (ms && !ms->treeBiases.empty()) {
+        std::vector<const TreeBias*> worst;
+        for (const TreeBias& t : ms->treeBiases) worst.push_back(&t);
+        std::sort(worst.begin(), worst.end(), [](const TreeBias* a, const TreeBias* b) {
+            return std::abs(a->luminanceBias) > std::abs(b->luminanceBias);
+        });
+        worst.resize(std::min<std::size_t>(worst.size(), 5));
+        s << "\nMultiscale (auto)'s trees farthest from the truth in luminance:";
+        for (const TreeBias* t : worst) {
+            s << (t == worst.front() ? " " : "; ") << "tree " << t->truth.tree << " ("
+              << std::lround(t->truth.coverage) << " px of foliage) " << percent(t->luminanceBias)
+              << ", coverage " << percent(t->coverageBias);
+        }
+        s << ".\n";
     }
     return s.str();
 }
@@ -392,7 +410,9 @@ std::string treesCsv(const CompareRun& run)
          "luminance_truth,luminance_bias\n"
       << std::setprecision(9);
     std::vector<const CompareRow*> rows;
-    for (const CompareRow& r : run.rows) rows.push_back(&r);
+    for (const CompareRow& r : run.rows) {
+        if (!r.truth) rows.push_back(&r);  // the truth's own biases are 0 by definition
+    }
     for (const BudgetRow& b : run.budget) rows.push_back(&b.row);
     for (const CompareRow* row : rows) {
         const CompareRow& r = *row;
@@ -519,7 +539,7 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
     if (c.plotted) s << "![RMSE against CPU seconds](error_vs_time.png)\n\n";
     s << "## Error at every scale\n\n" << scaleSection(run, c.plotted) << '\n';
     s << "## Speed at equal error\n\n" << speedSection(rows) << '\n';
-    s << "## Bias per tree\n\n" << treeSection(run) << '\n';
+    s << "## Bias per tree\n\n" << treeSection(run, c.treePlot) << '\n';
     s << "## Error budget\n\n" << budgetSection(run) << '\n';
     s << "## Where the bough law's error shows\n\n" << levelSection(rows) << '\n';
     s << "## Images\n\nPreviews over the scene's background; error maps of the luminance error "

@@ -17,6 +17,7 @@ struct ReportInfo {
     std::string machine;              ///< CPU, cores and threads, as the tool found them
     double errorScale = 1.0;          ///< luminance error shown white in every error map
     bool plotted = false;             ///< error_vs_time.png and error_vs_scale.png exist
+    bool treePlot = false;            ///< tree_bias.png exists
     const DollyFlicker* flicker = nullptr;  ///< null: no dolly was rendered
 };
 
