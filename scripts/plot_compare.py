@@ -60,6 +60,17 @@ def save(fig, directory, name):
     os.replace(tmp, out)
 
 
+def finish(fig, ax, directory, name, xlabel, ylabel, title):
+    """Labels, a grid and a two-column legend, then the file."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    save(fig, directory, name)
+
+
 def scales(rows):
     return sorted(int(c[len("rmse_k"):]) for c in rows[0] if c.startswith("rmse_k"))
 
@@ -96,13 +107,10 @@ def plot_scales(rows, directory):
     ax.set_yscale("log")
     ax.set_xticks(ks)
     ax.set_xticklabels([str(k) for k in ks])
-    ax.set_xlabel("k: both images box-downsampled by k x k pixels")
-    ax.set_ylabel("RMSE of luminance against the ground truth")
-    ax.set_title("Error at every scale: noise falls, bias stays")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    save(fig, directory, "error_vs_scale.png")
+    finish(fig, ax, directory, "error_vs_scale.png",
+           "k: both images box-downsampled by k x k pixels",
+           "RMSE of luminance against the ground truth",
+           "Error at every scale: noise falls, bias stays")
 
 
 def plot_trees(directory):
@@ -128,13 +136,8 @@ def plot_trees(directory):
         ax.scatter(xs, ys, color=colour, marker=marker, s=14,
                    alpha=max(0.3, 1.0 - 0.25 * shade), label=f"{method} {setting}")
     ax.set_xscale("log")
-    ax.set_xlabel("the tree's foliage in the truth (pixels)")
-    ax.set_ylabel("foliage luminance against the truth (%)")
-    ax.set_title("Bias per tree")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    save(fig, directory, "tree_bias.png")
+    finish(fig, ax, directory, "tree_bias.png", "the tree's foliage in the truth (pixels)",
+           "foliage luminance against the truth (%)", "Bias per tree")
 
 
 def main():
