@@ -99,7 +99,8 @@ def plot_scales(rows, directory):
         shades[r["method"]] = shade + 1
         ax.plot(xs, ys, color=colour, marker=marker, linestyle=LINES[shade % len(LINES)],
                 label=f"{r['method']} {r['setting']}")
-    top = max(float(r["rmse_k1"]) for r in rows if r.get("rmse_k1"))
+    top = max(float(r["rmse_k1"]) for r in rows
+              if r.get("rmse_k1") and not r["method"].startswith("budget:"))
     if top > 0:
         ax.plot(ks, [top / k for k in ks], color="black", linestyle="--", linewidth=0.8,
                 label="1 / k (noise alone)")
@@ -171,13 +172,9 @@ def main():
                         textcoords="offset points", ha="right", fontsize=8, color="grey")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("render CPU seconds (all threads, preparation included)")
-    ax.set_ylabel("RMSE of luminance against the ground truth")
-    ax.set_title("What accuracy costs in time")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    save(fig, directory, "error_vs_time.png")
+    finish(fig, ax, directory, "error_vs_time.png",
+           "render CPU seconds (all threads, preparation included)",
+           "RMSE of luminance against the ground truth", "What accuracy costs in time")
 
 
 if __name__ == "__main__":

@@ -51,6 +51,7 @@ Table readCsv(const fs::path& path)
             header = cells;
             continue;
         }
+        EXPECT_EQ(cells.size(), header.size()) << path << ": " << line;
         std::map<std::string, std::string> row;
         for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) {
             row[header[i]] = cells[i];
@@ -72,6 +73,7 @@ protected:
         options.sceneFile = dir / "fir.json";
         options.outDir = dir / "out";
         options.settings = CompareSettings::forQuick(true);
+        options.settings.repeat = 3;  // the median of three runs and its spread are reported
         // No plot: the CLI test plots; matplotlib need not be here.
         runCompare(options);
         status = 0;
@@ -257,6 +259,18 @@ TEST_F(Compare, ReportNumbersAreWhatTheWrittenImagesGive)
         };
         ASSERT_FALSE(luminance.empty()) << name;
         EXPECT_EQ(std::stoul(r.at("trees")), luminance.size()) << name;
+        for (const auto& [which, biases] :
+             {std::pair{"luminance", luminance}, std::pair{"coverage", coverage}}) {
+            const double worst =
+                *std::max_element(biases.begin(), biases.end(),
+                                  [](double x, double y) { return std::abs(x) < std::abs(y); });
+            const long beyond = std::count_if(biases.begin(), biases.end(),
+                                              [](double b) { return std::abs(b) > 0.03; });
+            EXPECT_TRUE(close(std::stod(r.at(std::string("tree_") + which + "_worst")), worst))
+                << name << " " << which;
+            EXPECT_EQ(std::stol(r.at(std::string("trees_") + which + "_beyond_3pct")), beyond)
+                << name << " " << which;
+        }
         EXPECT_TRUE(close(std::stod(r.at("tree_luminance_median")), median(luminance))) << name;
         EXPECT_TRUE(close(std::stod(r.at("tree_coverage_median")), median(coverage))) << name;
         EXPECT_TRUE(close(std::stod(r.at("foliage_coverage_bias")), cov / covTruth - 1.0)) << name;

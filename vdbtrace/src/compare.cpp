@@ -37,7 +37,7 @@ CompareRun runCompare(const CompareOptions& options)
     loadImageIo();
     scenes::Scene scene = scenes::loadScene(options.sceneFile);
     if (options.model) options.model(scene.render.model);
-    if (options.addSelfShadowing) scene.effects.selfShadowing = true;
+    if (options.addSelfShadowing) scene.effects.selfShadowing |= scene.effects.shadows;
     checkEffects(scene.effects);
     if (options.width > 0 && options.height > 0) {
         // fov_deg is vertical: the view is kept, and kept exactly when the aspect is.

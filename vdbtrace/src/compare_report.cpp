@@ -94,8 +94,10 @@ std::string truthSection(const CompareRun& run, const CompareSettings& st)
     if (const ImageErrors::AtScale* a = run.truthCheck->errors.atScale(kNamedScale)) {
         s << " and " << formatNumber(a->rmse) << " at k = " << kNamedScale;
     }
-    s << " (the check's own noise is in it: with f times the samples, sqrt(1 + 1 / f) times "
-         "the truth's alone, 12% over it at f = 4).";
+    const double f = double(run.truthCheck->samples) / st.truthSamples;
+    s << " (the check's own noise is in it: with f = " << formatNumber(f)
+      << " times the samples, sqrt(1 + 1 / f) = " << formatNumber(std::sqrt(1.0 + 1.0 / f), 3)
+      << " times the truth's alone).";
     if (closest) {
         s << " The closest render of the sweep, " << closest->method << ' ' << closest->setting
           << ", has " << formatNumber(least) << " per pixel: ";
@@ -163,8 +165,10 @@ std::string budgetSection(const CompareRun& run)
       << ", its per-tree bias (median, trees beyond 3%), the bias of all its foliage, and "
          "its CPU time, each with its change (a negative added error: the switch is nearer "
          "the truth). The reference's voxel size is the last rows'.\n\n"
-         "| approximation | the paper's | method | RMSE (added) | RMSE k=4 (added) | "
-         "per-tree luminance median | trees > 3% (own) | all foliage luminance | CPU s |\n"
+         "| approximation | the paper's | method | RMSE (added) | RMSE k="
+      << kNamedScale
+      << " (added) | per-tree luminance median | trees > 3% (own) | all foliage luminance | "
+         "CPU s |\n"
          "|---|---|---|---|---|---|---|---|---|\n";
     for (const BudgetRow& b : run.budget) {
         const CompareRow* own = b.what.method == "reference" ? finest : ownMultiscale;
@@ -500,7 +504,8 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
     s << " cm, " << st.subpixels * st.subpixels << " rays per pixel; multiscale: levels forced "
       << "to 1, 2, 3 and automatic\n";
     s << "- times: process CPU seconds (all threads) of each render, the median of " << st.repeat
-      << " run(s) by CPU seconds [the least, the most], what the method prepares first "
+      << " run(s) by CPU seconds [the least, the most] (the truth one run), what the method "
+         "prepares first "
          "included (prep: the geometry's Embree BVH, the reference's bake and light grids, in "
          "wall seconds); the multiscale times include the bough law's per-bough profiles, "
          "computed as the render first needs them, each run from a scene of its own\n";

@@ -85,14 +85,14 @@ void measureTrees(CompareRow& row, const CompareRow& truth)
 void checkEffects(const scenes::Effects& effects)
 {
     if (effects.shadows == effects.selfShadowing) return;
-    throw InputError(
-        std::string("the scene names \"") + (effects.shadows ? "shadows" : "self_shadowing") +
-        "\" without \"" + (effects.shadows ? "self_shadowing" : "shadows") +
-        "\", which geometry and reference cannot render (their needles and voxels shade "
-        "through their own bough as through any other): add \"" +
-        (effects.shadows ? "self_shadowing" : "shadows") +
-        "\" to the scene's effects (or pass --self-shadowing) so that every method computes "
-        "the same effects");
+    const std::string named = effects.shadows ? "shadows" : "self_shadowing";
+    const std::string missing = effects.shadows ? "self_shadowing" : "shadows";
+    throw InputError("the scene names \"" + named + "\" without \"" + missing +
+                     "\", which geometry and reference cannot render (their needles and "
+                     "voxels shade through their own bough as through any other): add \"" +
+                     missing + "\" to the scene's effects" +
+                     (effects.shadows ? " (compare --self-shadowing adds it)" : "") +
+                     " so that every method computes the same effects");
 }
 
 CompareSettings CompareSettings::forQuick(bool quick)
@@ -199,6 +199,7 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
         measure(render(builtAgain, "multiscale", "multiscale",
                        level ? "L" + std::to_string(level) : "auto", s, st.repeat));
     }
+    own.reset();  // the budget's renders build scenes of their own
     if (st.budget) {
         // Each switch against the row rendered with the scene's own choices: multiscale
         // (auto), and the reference at the finest voxel size.

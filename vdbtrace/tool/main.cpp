@@ -1084,8 +1084,9 @@ int main(int argc, char** argv)
     compareCmd->add_option("--out-dir", compare.outDir, "Folder for the report and images")
         ->required();
     compareCmd->add_flag("--quick", quick,
-                         "Fewer settings (truth 16 spp, geometry 1 and 4 spp, voxels 1 and "
-                         "0.5 cm) and an 8-frame dolly at half resolution");
+                         "Fewer settings (truth 16 spp checked against 64, geometry 1 and 4 "
+                         "spp, voxels 1 and 0.5 cm, one run each; the error budget still "
+                         "rendered) and an 8-frame dolly at half resolution");
     addResolution(*compareCmd, resolution, "WxH instead of the camera's (same view)", "64x48");
     compareCmd->add_flag("--no-plot", noPlot,
                          "Skip error_vs_time.png and error_vs_scale.png (matplotlib)");
@@ -1103,9 +1104,9 @@ int main(int argc, char** argv)
     compareCmd->add_flag("--no-budget", noBudget,
                          "Skip the error budget (each model choice's alternatives alone)");
     compareCmd->add_flag("--self-shadowing", compare.addSelfShadowing,
-                         "Add self_shadowing to the scene's effects: the explicit needles "
-                         "always self-shadow, so a scene with shadows alone is refused "
-                         "without it");
+                         "Add self_shadowing where the scene's effects name shadows: the "
+                         "explicit needles always self-shadow, so a scene with shadows alone "
+                         "is refused without it");
     addMaxMemory(*compareCmd, maxMemoryGiB, "a comparison");
     model.add(*compareCmd);
 

@@ -17,8 +17,9 @@ struct CompareOptions {
     /// Adjusts the scene's model choices after it is read (the command line's overrides).
     std::function<void(scenes::ModelChoices&)> model;
     int width = 0, height = 0;  ///< override of the camera's resolution (0: the scene's)
-    /// Adds "self_shadowing" to the scene's effects: the explicit needles always self-shadow,
-    /// so a scene with "shadows" alone is compared with both (checkEffects).
+    /// Adds "self_shadowing" where the scene's effects name "shadows": the explicit needles
+    /// always self-shadow, so a scene with "shadows" alone is compared with both
+    /// (checkEffects); a scene without shadows is left as it is.
     bool addSelfShadowing = false;
     double maxMemoryBytes = 0.0;  ///< refuse, before any work, a run estimated to need more
     bool flicker = true;        ///< render the dolly (flicker.csv)

@@ -25,8 +25,9 @@ struct CompareSettings {
     /// The truth is measured against a render of this many times its samples (another shift):
     /// its own error, which the methods' must exceed for theirs to mean anything. 0: none.
     int truthCheckFactor = 4;
-    /// Runs of each render; its time is the median run's by CPU seconds, with the least and
-    /// the most (a shared machine's load moves single runs by a third).
+    /// Runs of each render (odd: an even count takes the upper of the middle two); its time is
+    /// the median run's by CPU seconds, with the least and the most (a shared machine's load
+    /// moves single runs by a third). The truth and its check are rendered once.
     int repeat = 3;
     /// Also render the error budget (error_budget.h): every alternative of every model
     /// choice alone, multiscale (auto) or the reference at the finest voxel size.
