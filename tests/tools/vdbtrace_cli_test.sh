@@ -72,6 +72,7 @@ expect_error "fine voxels" 2 "voxels of 0.0001 cm" -- render "$src/scenes/three-
 expect_error "compare, huge resolution" 2 "at most 16384" -- compare "$src/scenes/bough.json" --resolution 100000x100000 --out-dir "$work/cmp"
 expect_error "compare, large resolution" 2 "images kept for the report needs about" -- compare "$src/scenes/bough.json" --resolution 16000x16000 --out-dir "$work/cmp" --max-memory 8
 expect_error "compare, an even repeat" 2 "odd number" -- compare "$src/scenes/bough.json" --repeat 2 --out-dir "$work/cmp"
+expect_error "bench, a repeat with a tail" 2 "odd number" -- bench "$src/scenes/bough.json" --repeat 3x
 expect_error "compare, shadows without self-shadowing" 2 'without "self_shadowing"' -- compare "$src/scenes/hill.json" --quick --resolution 32x24 --out-dir "$work/cmp"
 [ -z "$(ls -A "$work/cmp" 2>/dev/null)" ] || fail "a refused compare wrote $(ls "$work/cmp")"
 rm -rf "$work/cmp"  # made, empty, by the check that it can be written

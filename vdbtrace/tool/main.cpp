@@ -800,8 +800,9 @@ CLI::Validator oddRuns()
     return CLI::Validator(
         [](std::string& text) -> std::string {
             try {
-                const int k = std::stoi(text);
-                if (k >= 1 && k <= 15 && k % 2 == 1) return {};
+                std::size_t used = 0;
+                const int k = std::stoi(text, &used);
+                if (used == text.size() && k >= 1 && k <= 15 && k % 2 == 1) return {};
             } catch (const std::exception&) {
             }
             return "must be an odd number from 1 to 15 (the median is one run), got '" + text +
