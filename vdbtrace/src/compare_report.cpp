@@ -19,12 +19,6 @@ bool hasLevels(const CompareRow& row)
 // The scale at which "equal error" is stated besides per pixel (issue: a fair comparison).
 constexpr int kNamedScale = 4;
 
-double rmseAt(const CompareRow& row, int k)
-{
-    const ImageErrors::AtScale* a = row.errors.atScale(k);
-    return a ? a->rmse : row.errors.rmse;
-}
-
 std::string percent(double fraction)
 {
     return formatNumber(100.0 * fraction, 3) + "%";
@@ -113,6 +107,17 @@ std::string truthSection(const CompareRun& run, const CompareSettings& st)
     return s.str();
 }
 
+// Every row the CSVs list: the sweep's (the truth too if `truth`), then the budget's.
+std::vector<const CompareRow*> sweepThenBudget(const CompareRun& run, bool truth)
+{
+    std::vector<const CompareRow*> rows;
+    for (const CompareRow& r : run.rows) {
+        if (truth || !r.truth) rows.push_back(&r);
+    }
+    for (const BudgetRow& b : run.budget) rows.push_back(&b.row);
+    return rows;
+}
+
 // "value (change)" of a switched row against its own.
 std::string withChange(double value, double own, bool asPercent)
 {
@@ -129,7 +134,7 @@ std::string budgetLine(const std::string& what, const std::string& paper, const 
     std::ostringstream s;
     s << "| " << what << " | " << paper << " | " << method << " | "
       << withChange(row.errors.rmse, own.errors.rmse, false) << " | "
-      << withChange(rmseAt(row, kNamedScale), rmseAt(own, kNamedScale), false) << " | ";
+      << withChange(rmseAtScale(row, kNamedScale), rmseAtScale(own, kNamedScale), false) << " | ";
     if (row.trees.trees && own.trees.trees) {
         s << withChange(row.trees.luminance.median, own.trees.luminance.median, true) << " | "
           << row.trees.luminance.beyond << " (" << own.trees.luminance.beyond << ") | ";
@@ -236,33 +241,20 @@ std::string treeSection(const CompareRun& run, bool treePlot)
     return s.str();
 }
 
-// The fastest geometry render (not the truth) whose RMSE at scale k is at most `rmse`.
-const CompareRow* cheapestGeometryAt(const std::vector<CompareRow>& rows, int k, double rmse)
-{
-    const CompareRow* cheapest = nullptr;
-    for (const CompareRow& r : rows) {
-        if (r.method == "geometry" && rmseAt(r, k) <= rmse &&
-            (!cheapest || r.seconds < cheapest->seconds)) {
-            cheapest = &r;
-        }
-    }
-    return cheapest;
-}
-
 std::string speedAt(const std::vector<CompareRow>& rows, int k)
 {
     std::ostringstream s;
     const CompareRow* ms = findRow(rows, "multiscale", "auto");
     if (!ms) return "Multiscale (auto) was not rendered.\n";
-    const double e = rmseAt(*ms, k);
-    const CompareRow* cheapest = cheapestGeometryAt(rows, k, e);
+    const double e = rmseAtScale(*ms, k);
+    const CompareRow* cheapest = cheapestGeometryWithin(rows, e, k);
     s << "- **" << (k == 1 ? "per pixel (k = 1)" : "at k = " + std::to_string(k))
       << "**: multiscale (auto) RMSE " << formatNumber(e) << " in " << formatNumber(ms->seconds, 3)
       << " CPU-s. ";
     if (cheapest) {
         const double ratio = cheapest->seconds / ms->seconds;
         s << "The cheapest geometry setting at equal or lower RMSE is " << cheapest->setting << " ("
-          << formatNumber(rmseAt(*cheapest, k)) << ", " << formatNumber(cheapest->seconds, 3)
+          << formatNumber(rmseAtScale(*cheapest, k)) << ", " << formatNumber(cheapest->seconds, 3)
           << " CPU-s, its BVH included): speed ratio "
           << "(geometry / multiscale) **" << formatNumber(ratio, 3) << "**, "
           << (ratio >= 1.0 ? "multiscale " + formatNumber(ratio, 3) + " times faster"
@@ -271,11 +263,12 @@ std::string speedAt(const std::vector<CompareRow>& rows, int k)
     } else {
         const CompareRow* best = nullptr;
         for (const CompareRow& r : rows) {
-            if (r.method == "geometry" && (!best || rmseAt(r, k) < rmseAt(*best, k))) best = &r;
+            if (r.method == "geometry" && (!best || rmseAtScale(r, k) < rmseAtScale(*best, k)))
+                best = &r;
         }
         s << "**No geometry setting of the sweep reaches it**";
         if (best) {
-            s << " (the best, " << best->setting << ", has " << formatNumber(rmseAt(*best, k))
+            s << " (the best, " << best->setting << ", has " << formatNumber(rmseAtScale(*best, k))
               << " in " << formatNumber(best->seconds, 3) << " CPU-s)";
         }
         s << "; no ratio is extrapolated.\n";
@@ -368,10 +361,7 @@ std::string reportCsv(const CompareRun& run)
             if (const ImageErrors::AtScale* a = e.atScale(k)) s << a->mae;
         }
     };
-    std::vector<const CompareRow*> rows;
-    for (const CompareRow& r : run.rows) rows.push_back(&r);
-    for (const BudgetRow& b : run.budget) rows.push_back(&b.row);
-    for (const CompareRow* row : rows) {
+    for (const CompareRow* row : sweepThenBudget(run, true)) {
         const CompareRow& r = *row;
         s << r.method << ',' << r.setting << ',' << r.seconds << ',' << r.secondsMin << ','
           << r.secondsMax << ',' << r.wallSeconds << ',' << r.runs << ',';
@@ -413,12 +403,8 @@ std::string treesCsv(const CompareRun& run)
     s << "method,setting,tree,coverage_px,coverage_px_truth,coverage_bias,luminance,"
          "luminance_truth,luminance_bias\n"
       << std::setprecision(9);
-    std::vector<const CompareRow*> rows;
-    for (const CompareRow& r : run.rows) {
-        if (!r.truth) rows.push_back(&r);  // the truth's own biases are 0 by definition
-    }
-    for (const BudgetRow& b : run.budget) rows.push_back(&b.row);
-    for (const CompareRow* row : rows) {
+    // The truth's own biases are 0 by definition.
+    for (const CompareRow* row : sweepThenBudget(run, false)) {
         const CompareRow& r = *row;
         for (const TreeBias& t : r.treeBiases) {
             s << r.method << ',' << r.setting << ',' << t.truth.tree << ',' << t.image.coverage

@@ -130,12 +130,14 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
     const auto built = [&](int) -> const TracedScene& { return traced; };
     // The bough law's profiles are computed as a multiscale render first needs them
     // (traced_scene.h) and belong to its time: each run starts from a scene of its own, so
-    // that none inherits another's.
+    // that none inherits another's. One at a time: the last is let go before the next is built.
     std::optional<TracedScene> own;
-    const auto builtAgain = [&](int) -> const TracedScene& {
-        own.reset();
-        own.emplace(buildTracedScene(scene));
-        return *own;
+    const auto builtAgainFrom = [&own](const scenes::Scene& from) {
+        return [&own, &from](int) -> const TracedScene& {
+            own.reset();
+            own.emplace(buildTracedScene(from));
+            return *own;
+        };
     };
 
     const auto judge = [&](CompareRow& row) {
@@ -196,10 +198,9 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
     }
     for (int level : st.levels) {
         s.multiscale.forceLevel = level;
-        measure(render(builtAgain, "multiscale", "multiscale",
+        measure(render(builtAgainFrom(scene), "multiscale", "multiscale",
                        level ? "L" + std::to_string(level) : "auto", s, st.repeat));
     }
-    own.reset();  // the budget's renders build scenes of their own
     if (st.budget) {
         // Each switch against the row rendered with the scene's own choices: multiscale
         // (auto), and the reference at the finest voxel size.
@@ -210,16 +211,10 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
             if (reference ? finest == st.voxelSizes_cm.end() : !automatic) continue;
             scenes::Scene switched = scene;
             switched.render.model = what.model;
-            std::optional<TracedScene> switchedTraced;
-            const auto sceneFor = [&](int) -> const TracedScene& {
-                switchedTraced.reset();
-                switchedTraced.emplace(buildTracedScene(switched));
-                return *switchedTraced;
-            };
             s.multiscale.forceLevel = 0;
             if (reference) s.voxelSize_cm = *finest;
-            CompareRow row =
-                render(sceneFor, what.method, "budget:" + what.method, what.label, s, st.repeat);
+            CompareRow row = render(builtAgainFrom(switched), what.method, "budget:" + what.method,
+                                    what.label, s, st.repeat);
             judge(row);
             row.image = Image();  // only its numbers are reported
             run.budget.push_back({what, std::move(row)});
@@ -238,11 +233,17 @@ const CompareRow* findRow(const std::vector<CompareRow>& rows, const std::string
     return nullptr;
 }
 
-const CompareRow* cheapestGeometryWithin(const std::vector<CompareRow>& rows, double rmse)
+double rmseAtScale(const CompareRow& row, int k)
+{
+    const ImageErrors::AtScale* a = row.errors.atScale(k);
+    return a ? a->rmse : row.errors.rmse;
+}
+
+const CompareRow* cheapestGeometryWithin(const std::vector<CompareRow>& rows, double rmse, int k)
 {
     const CompareRow* cheapest = nullptr;
     for (const CompareRow& r : rows) {
-        if (r.method == "geometry" && r.errors.rmse <= rmse &&
+        if (r.method == "geometry" && rmseAtScale(r, k) <= rmse &&
             (!cheapest || r.seconds < cheapest->seconds)) {
             cheapest = &r;
         }

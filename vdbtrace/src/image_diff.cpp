@@ -73,6 +73,7 @@ ImageErrors compareImages(const Image& image, const Image& reference)
     const auto levelAov = image.aovs.find("level");
     const bool hasLevels = levelAov != image.aovs.end() && levelAov->second.size() == n;
     std::vector<double> levelSq(4, 0.0), levelRel(4, 0.0);
+    std::vector<double> signedError(n);  // for the scales below
     if (hasLevels) e.byLevel.resize(4);
     for (std::size_t i = 0; i < n; ++i) {
         const float* a = &image.rgba[4 * i];
@@ -80,7 +81,9 @@ ImageErrors compareImages(const Image& image, const Image& reference)
         float* out = &e.error.rgba[4 * i];
         for (int c = 0; c < 3; ++c) out[c] = std::abs(a[c] - b[c]);
         out[3] = 1.0f;
-        const double ref = luminance(b), d = std::abs(luminance(a) - ref);
+        const double ref = luminance(b);
+        signedError[i] = luminance(a) - ref;
+        const double d = std::abs(signedError[i]);
         lum[i] = float(d);
         sumSq += d * d;
         e.maxAbsolute = std::max(e.maxAbsolute, d);
@@ -105,10 +108,6 @@ ImageErrors compareImages(const Image& image, const Image& reference)
         l.meanRelative = l.relativePixels ? levelRel[k] / double(l.relativePixels) : 0.0;
     }
     // Luminance is linear in RGB, so a block's mean error is the error of the blocks' means.
-    std::vector<double> signedError(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        signedError[i] = luminance(&image.rgba[4 * i]) - luminance(&reference.rgba[4 * i]);
-    }
     for (const int k : kErrorScales) {
         const int bw = image.width / k, bh = image.height / k;
         if (bw < 1 || bh < 1) continue;

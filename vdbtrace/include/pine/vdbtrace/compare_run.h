@@ -105,8 +105,13 @@ void checkEffects(const scenes::Effects& effects);
 /// A number for a person: `digits` significant digits.
 std::string formatNumber(double value, int digits = 4);
 
-/// The fastest geometry render of the sweep (not the truth) with RMSE <= `rmse`, or null.
-const CompareRow* cheapestGeometryWithin(const std::vector<CompareRow>& rows, double rmse);
+/// A row's RMSE after box-downsampling by k (ImageErrors::byScale); per pixel where the image
+/// has no whole k x k block.
+double rmseAtScale(const CompareRow& row, int k);
+/// The fastest geometry render of the sweep (not the truth) whose RMSE at scale k is at most
+/// `rmse`, or null.
+const CompareRow* cheapestGeometryWithin(const std::vector<CompareRow>& rows, double rmse,
+                                         int k = 1);
 /// The row of `method` at `setting`, or null.
 const CompareRow* findRow(const std::vector<CompareRow>& rows, const std::string& method,
                           const std::string& setting);
