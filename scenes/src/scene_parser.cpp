@@ -51,6 +51,86 @@ Camera readCamera(const Json& value, const Where& where)
     return c;
 }
 
+// Why a camera cannot render, or empty: the checks a still camera's keys get, for any camera
+// a path passes through.
+std::string cameraProblem(const Camera& c)
+{
+    const Vec3 view = c.lookAt_cm - c.position_cm;
+    if (!(glm::length(view) > 0.0)) return "look_at equals position (no view direction)";
+    if (!(glm::length(glm::cross(glm::normalize(view), c.up)) >= 1e-6)) {
+        return "up is parallel to the view direction (or zero)";
+    }
+    if (!(c.fovY_rad > 0.0 && c.fovY_rad < std::numbers::pi)) {
+        return "fov_deg " + detail::formatNumber(c.fovY_rad / kRadPerDeg) + " is outside (0, 180)";
+    }
+    return {};
+}
+
+constexpr long long kMaxFrame = 9999999;
+constexpr long long kMaxFrames = 100000;
+
+// "camera_path": keys that each change what they name of the camera before them (the first
+// key, of the still camera), the frames to render and how to interpolate.
+CameraPath readCameraPath(const Json& value, const Where& where, const Camera& still)
+{
+    ObjectReader r(value, where);
+    CameraPath path;
+    const Json& keys = r.required("keys");
+    const Where keysAt = where.key("keys");
+    if (!keys.is_array() || keys.empty()) keysAt.fail("must be an array of at least one key");
+    CameraKey last{0.0, still.position_cm, still.lookAt_cm, still.up, still.fovY_rad};
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+        ObjectReader k(keys[i], keysAt.index(i));
+        CameraKey key = last;
+        key.frame = k.number("frame", Range::closed(0.0, double(kMaxFrame)));
+        if (i > 0 && !(key.frame > last.frame)) {
+            k.where().key("frame").fail("must exceed the previous key's (" +
+                                        detail::formatNumber(last.frame) + ")");
+        }
+        if (k.has("position")) key.position_cm = k.vec3("position");
+        if (k.has("look_at")) key.lookAt_cm = k.vec3("look_at");
+        if (const Json* up = k.optional("up")) {
+            key.up = detail::readDirection(*up, k.where().key("up"));
+        }
+        key.fovY_rad =
+            kRadPerDeg * k.number("fov_deg", Range::open(0, 180), key.fovY_rad / kRadPerDeg);
+        k.finish();
+        path.keys.push_back(key);
+        last = key;
+    }
+    if (const Json* frames = r.optional("frames")) {
+        const Where at = where.key("frames");
+        if (!frames->is_array() || frames->size() != 2) {
+            at.fail("must be [first, last], frame numbers");
+        }
+        path.firstFrame = int(detail::readInteger((*frames)[0], at.index(0), 0, kMaxFrame));
+        path.lastFrame =
+            int(detail::readInteger((*frames)[1], at.index(1), path.firstFrame, kMaxFrame));
+    } else {
+        path.firstFrame = int(std::ceil(path.keys.front().frame));
+        path.lastFrame = std::max(path.firstFrame, int(std::floor(path.keys.back().frame)));
+    }
+    if (path.frameCount() > kMaxFrames) {
+        where.key("frames").fail(std::to_string(path.frameCount()) + " frames, more than " +
+                                 std::to_string(kMaxFrames));
+    }
+    path.framesPerSecond = r.number("fps", Range::above(0.0), path.framesPerSecond);
+    const std::string interpolation = r.string("interpolation", "smooth");
+    if (interpolation == "linear") {
+        path.interpolation = CameraPath::Interpolation::Linear;
+    } else if (interpolation != "smooth") {
+        where.key("interpolation")
+            .fail("must be \"smooth\" or \"linear\" (is \"" + interpolation + "\")");
+    }
+    r.finish();
+    // Every frame it renders is a camera that can render: a smooth curve may overshoot its keys.
+    for (int f = path.firstFrame; f <= path.lastFrame; ++f) {
+        const std::string problem = cameraProblem(path.at(f, still));
+        if (!problem.empty()) where.fail("at frame " + std::to_string(f) + ", " + problem);
+    }
+    return path;
+}
+
 void readLights(const Json& value, const Where& where, Scene& scene)
 {
     if (!value.is_array() || value.empty()) where.fail("must be an array of at least one light");
@@ -177,6 +257,9 @@ Scene parseScene(const std::string& json, const std::filesystem::path& name)
     scene.source = name;
     scene.name = r.string("name", name.stem().string());
     scene.camera = readCamera(r.required("camera"), top.key("camera"));
+    if (const Json* path = r.optional("camera_path")) {
+        scene.cameraPath = readCameraPath(*path, top.key("camera_path"), scene.camera);
+    }
     readLights(r.required("lights"), top.key("lights"), scene);
     if (const Json* ground = r.optional("ground")) {
         scene.ground = readGround(*ground, top.key("ground"));

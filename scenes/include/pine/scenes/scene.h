@@ -5,6 +5,7 @@
 
 #include "pine/support/input_error.h"
 
+#include "pine/scenes/camera.h"
 #include "pine/scenes/species.h"
 
 #include <glm/vec2.hpp>
@@ -18,7 +19,6 @@
 
 namespace pine::scenes {
 
-using Vec3 = glm::dvec3;
 using Vec2 = glm::dvec2;
 
 /// A scene file that cannot be used: the message is one line naming file, key and, where the
@@ -26,14 +26,6 @@ using Vec2 = glm::dvec2;
 class SceneError : public InputError {
 public:
     using InputError::InputError;
-};
-
-struct Camera {
-    Vec3 position_cm{0.0, -500.0, 100.0};
-    Vec3 lookAt_cm{0.0, 0.0, 100.0};
-    Vec3 up{0.0, 0.0, 1.0};
-    double fovY_rad = 0.7;  ///< vertical field of view
-    int width = 640, height = 480;
 };
 
 struct PointLight {
@@ -130,6 +122,7 @@ struct Scene {
     std::filesystem::path source;  ///< the file it came from (for messages and metadata)
     std::string name;
     Camera camera;
+    CameraPath cameraPath;  ///< empty: the camera stands still
     std::vector<PointLight> pointLights;
     std::vector<DirectionalLight> directionalLights;
     Ground ground;
