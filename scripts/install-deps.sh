@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev
   libembree-dev
+  openmpi-bin libopenmpi-dev
   python3-matplotlib python3-numpy python3-openvdb
 )
 

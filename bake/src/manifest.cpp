@@ -16,21 +16,6 @@ namespace pine::bake::detail {
 
 namespace fs = std::filesystem;
 
-void Fnv1a64::update(std::string_view bytes)
-{
-    for (const char c : bytes) {
-        mHash ^= std::uint64_t(static_cast<unsigned char>(c));
-        mHash *= 1099511628211ull;
-    }
-}
-
-std::string Fnv1a64::hex(std::uint64_t hash)
-{
-    char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
-    return text;
-}
-
 FileDigest digestFile(const fs::path& file)
 {
     std::ifstream in(file, std::ios::binary);

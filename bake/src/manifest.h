@@ -3,6 +3,8 @@
 // crash OpenVDB 10.0.1: DESIGN.md). Private to bake/.
 #pragma once
 
+#include "pine/support/fnv1a.h"
+
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -11,16 +13,7 @@
 
 namespace pine::bake::detail {
 
-/// FNV-1a, 64 bits: not cryptographic; it detects damage, not forgery.
-class Fnv1a64 {
-public:
-    void update(std::string_view bytes);
-    std::uint64_t value() const { return mHash; }
-    static std::string hex(std::uint64_t hash);  ///< 16 lower-case digits
-
-private:
-    std::uint64_t mHash = 14695981039346656037ull;
-};
+using io::Fnv1a64;
 
 struct FileDigest {
     std::uintmax_t bytes = 0;

@@ -81,6 +81,11 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
 
 bool quiet() { return gQuiet; }
 
+void setQuiet(bool quiet)
+{
+    gQuiet = quiet;
+}
+
 std::ostream& info()
 {
     static NullBuffer nothing;

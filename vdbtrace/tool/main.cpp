@@ -5,6 +5,7 @@
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/support/atomic_file.h"
+#include "pine/support/fnv1a.h"
 #include "pine/support/folder_lock.h"
 #include "pine/support/plot_script.h"
 #include "pine/support/process_clock.h"
@@ -13,6 +14,8 @@
 #include "pine/vdbtrace/compare.h"
 #include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/exr_output.h"
+#include "pine/vdbtrace/frame_parts.h"
+#include "pine/vdbtrace/frame_sequence.h"
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
@@ -20,15 +23,16 @@
 #include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/preview.h"
+#include "pine/vdbtrace/ranks.h"
 #include "pine/vdbtrace/reference_tracer.h"
 #include "pine/vdbtrace/scene_growth.h"
 #include "pine/vdbtrace/stats_json.h"
 #include "pine/vdbtrace/traced_scene.h"
 #include "pine/vdbtrace/tree_foliage.h"
 
-#include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
-
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -36,9 +40,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <map>
+#include <cstring>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -230,12 +235,74 @@ vdbtrace::TracedSceneParts partsWithin(const vdbtrace::RenderMethod& method, dou
     return parts;
 }
 
+/// What names a frame's render, so that a resumed job keeps only frames rendered as it would
+/// render them: the scene file's bytes and every option that changes a pixel.
+std::string frameJobDigest(const fs::path& sceneFile, const std::string& methodName,
+                           const vdbtrace::MethodSettings& settings,
+                           const std::vector<fs::path>& gridFiles, const ModelOverrides& model,
+                           const FrameOverrides& frame, const std::vector<std::string>& aovs)
+{
+    std::ifstream in(sceneFile, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    nlohmann::json job = {{"scene", text.str()},
+                          {"method", methodName},
+                          {"voxel_size", settings.voxelSize_cm},
+                          {"subpixels", settings.reference.subpixels},
+                          {"samples", settings.geometry.samples},
+                          {"sample_seed", settings.geometry.sampleSeed},
+                          {"primitive", int(settings.geometry.primitive)},
+                          {"force_level", settings.multiscale.forceLevel},
+                          {"paper", model.paper},
+                          {"bough_law", model.boughLaw},
+                          {"layer_model", model.layerModel},
+                          {"extinction_law", model.extinctionLaw},
+                          {"shadow_origin", model.shadowOrigin},
+                          {"bark", model.bark},
+                          {"layer_correlation", model.layerCorrelation},
+                          {"level_blend", model.levelBlend},
+                          {"cone_level_max", model.coneLevelMax},
+                          {"resolution", {frame.width, frame.height}},
+                          {"crop", {frame.crop.x0, frame.crop.y0, frame.crop.x1, frame.crop.y1}},
+                          {"aovs", aovs}};
+    for (const fs::path& g : gridFiles) job["grids"].push_back(fs::absolute(g).string());
+    io::Fnv1a64 hash;
+    hash.update(job.dump());
+    return io::Fnv1a64::hex(hash.value());
+}
+
+/// Whether `file` is a frame this job rendered: written whole (frames are renamed into place
+/// complete) and recording `job`.
+bool frameComplete(const fs::path& file, const std::string& job)
+{
+    std::error_code error;
+    if (!fs::exists(file, error)) return false;
+    vdbtrace::Metadata metadata;
+    try {
+        vdbtrace::readExr(file, &metadata);
+    } catch (const vdbtrace::ImageError&) {
+        return false;  // damaged: rendered again
+    }
+    for (const auto& [key, value] : metadata) {
+        if (key == "pine:job") {
+            const auto* text = std::get_if<std::string>(&value);
+            return text && *text == job;
+        }
+    }
+    return false;
+}
+
 int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs,
            vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles,
            const ModelOverrides& model, const FrameOverrides& frame, double maxMemoryGiB,
-           double lawCacheMiB)
+           double lawCacheMiB, const std::optional<vdbtrace::FrameRange>& frameRange,
+           vdbtrace::Ranks& ranks)
 {
+    using Clock = std::chrono::steady_clock;
+    const auto started = Clock::now();
+    const bool animation = frameRange.has_value();
+    const bool leader = ranks.rank() == 0;
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
     vdbtrace::TracedSceneParts parts = partsWithin(method, lawCacheMiB);
     // The extension decides the format: only EXR holds the render (its PNG goes beside it).
@@ -245,8 +312,18 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         throw InputError("--out '" + out.string() + "': the render is written as OpenEXR and " +
                          "its name must end in .exr (a PNG preview is written beside it)");
     }
-    io::checkWritable(out);
-    if (!statsFile.empty()) io::checkWritable(statsFile);
+    // A frame's files: NAME.####.exr and its previews, stats as STATS.####.json.
+    const auto exrOf = [&](std::optional<int> f) { return f ? vdbtrace::frameFile(out, *f) : out; };
+    const auto statsOf = [&](std::optional<int> f) {
+        return f && !statsFile.empty() ? vdbtrace::frameFile(statsFile, *f, ".json") : statsFile;
+    };
+    const fs::path first = animation ? exrOf(frameRange->first) : out;
+    const fs::path firstStats = animation ? statsOf(frameRange->first) : statsFile;
+    // Only the leader writes (the other ranks' machines may not see its folders).
+    if (leader) {
+        io::checkWritable(first);
+        if (!statsFile.empty()) io::checkWritable(firstStats);
+    }
     std::vector<fs::path> inputs = {sceneFile};
     for (const fs::path& g : gridFiles) {
         inputs.push_back(g);
@@ -257,10 +334,35 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         throw InputError("--aov level: method '" + methodName +
                          "' has no levels (multiscale shades at the paper's levels)");
     }
-    io::checkOutputsApart({out, besideWith(out, ".png"),
-                           levelPng ? besideWith(out, ".level.png") : fs::path(), statsFile},
+    io::checkOutputsApart({first, besideWith(first, ".png"),
+                           levelPng ? besideWith(first, ".level.png") : fs::path(), firstStats},
                           inputs);
     vdbtrace::loadImageIo();
+    // Frames of an interrupted job already rendered as this one would are kept: the leader
+    // looks, every rank hears which are left.
+    const std::string job =
+        frameJobDigest(sceneFile, methodName, settings, gridFiles, model, frame, aovs);
+    std::vector<int> toRender;
+    if (animation) {
+        if (leader) {
+            toRender = vdbtrace::framesLeft(*frameRange,
+                                            [&](int f) { return frameComplete(exrOf(f), job); });
+        }
+        vdbtrace::Bytes list(toRender.size() * sizeof(int));
+        std::memcpy(list.data(), toRender.data(), list.size());
+        ranks.broadcast(list, 0);
+        toRender.resize(list.size() / sizeof(int));
+        std::memcpy(toRender.data(), list.data(), list.size());
+        const int done = frameRange->count() - int(toRender.size());
+        if (done > 0) {
+            tool::info() << "vdbtrace: " << done << " of " << frameRange->count()
+                         << " frames already rendered by this job, kept\n";
+        }
+        if (toRender.empty()) {
+            tool::info() << "vdbtrace: nothing left to render\n";
+            return 0;
+        }
+    }
     // Baked files first: a damaged one is refused before any work.
     std::optional<bake::TreeGrids> baked;
     std::vector<bake::BakeProvenance> bakedFrom;
@@ -278,6 +380,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         baked = bake::mergeTreeGrids(trees);  // checked against manifests or their metadata
         settings.grids = &*baked;
     }
+    // The frame this rank renders first: the traced scene is built for it.
+    const int firstOfMine =
+        animation ? toRender[std::min(toRender.size() - 1, std::size_t(ranks.rank()))] : 0;
     const auto loaded = load(
         sceneFile, model,
         [&](const scenes::Scene& scene) {
@@ -319,6 +424,12 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                 scene.camera.width = frame.width;
                 scene.camera.height = frame.height;
             }
+            if (!animation) return;
+            if (scene.cameraPath.empty()) {
+                throw InputError("--frames: '" + sceneFile.string() +
+                                 "' has no camera_path (docs/scene-format.md) to move along");
+            }
+            scene.camera = scene.cameraPath.at(firstOfMine, scene.camera);
         },
         parts);
     std::map<int, fs::path> treesRead;  // a tree given twice would be drawn twice
@@ -358,102 +469,226 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     if (methodName == "reference" && !baked) {
         tool::info() << "vdbtrace: baking the boughs at " << settings.voxelSize_cm << " cm\n";
     }
-    tool::Progress rendering("vdbtrace: rendering");
-    vdbtrace::RenderOptions options = withProgress(rendering);
-    options.window = frame.crop;
-    const vdbtrace::RenderResult result = method.render(loaded->traced, settings, options);
-    rendering.finish();
-    const vdbtrace::LawProfileCounts profiles = vdbtrace::lawProfileCounts(loaded->traced);
-    const std::size_t columnsBytes = vdbtrace::lightColumnsBytes(loaded->traced);
-    // What is written is the image alone: the traced scene (most of a landscape's memory) goes
-    // before the files are made.
-    loaded->traced = vdbtrace::TracedScene();
-
+    const scenes::Camera still = loaded->scene.camera;
+    const scenes::CameraPath& path = loaded->scene.cameraPath;
+    // The traced scene is prepared for one camera (each bough's law sees it): again per frame.
+    // What this rank's renders kept (law profiles, shadow columns) is read before it goes.
+    std::optional<int> tracedFor = animation ? std::optional<int>(firstOfMine) : std::nullopt;
+    nlohmann::json kept;
+    const auto renderAt = [&](std::optional<int> f, const vdbtrace::PixelWindow& window,
+                              bool last) {
+        if (f != tracedFor) {
+            loaded->scene.camera = path.at(*f, still);
+            loaded->traced = vdbtrace::buildTracedScene(loaded->scene, parts);
+            tracedFor = f;
+        }
+        tool::Progress rendering(f ? "vdbtrace: frame " + std::to_string(*f)
+                                   : std::string("vdbtrace: rendering"));
+        vdbtrace::RenderOptions options = withProgress(rendering);
+        options.window = window;
+        vdbtrace::RenderResult result = method.render(loaded->traced, settings, options);
+        rendering.finish();
+        const vdbtrace::LawProfileCounts profiles = vdbtrace::lawProfileCounts(loaded->traced);
+        const std::size_t columnsBytes = vdbtrace::lightColumnsBytes(loaded->traced);
+        const auto counted = [](const vdbtrace::ProfileCounts& c) {
+            return nlohmann::json{
+                {"computed", c.computed}, {"dropped", c.dropped}, {"bytes", c.bytes}};
+        };
+        kept = nlohmann::json::object();
+        if (profiles.views.computed + profiles.fromLights.computed > 0) {
+            kept["law_profiles"] = {{"views", counted(profiles.views)},
+                                    {"from_lights", counted(profiles.fromLights)},
+                                    {"peak_bytes", profiles.peakBytes}};
+        }
+        if (columnsBytes > 0) kept["shadow_columns_bytes"] = columnsBytes;
+        // What is written is the image alone: the traced scene (most of a landscape's
+        // memory) goes before the files are made.
+        if (last) {
+            loaded->traced = vdbtrace::TracedScene();
+            tracedFor = -1;
+        }
+        return result;
+    };
     const auto& s = loaded->scene;
     const nlohmann::json effects = vdbtrace::toJson(vdbtrace::EffectsPlan::from(s.effects));
-    const nlohmann::json methodSettings = method.describe(s, settings);
-    const vdbtrace::ConeCamera camera(s.camera);
-    // As compositors and pbrt-v4 read an EXR: render time, samples (pbrt-v4's names) and
-    // OpenEXR's camera matrices, typed; the rest under pine:, numbers as numbers.
-    vdbtrace::Metadata metadata = vdbtrace::cameraMetadata(camera);
-    metadata.insert(metadata.end(), {
-        {"renderTimeSeconds", float(result.seconds)},
-        {"samplesPerPixel", method.samplesPerPixel(settings)},
-        {"pine:scene", sceneFile.string()},
-        {"pine:method", methodName},
-        {"pine:render_seconds", float(result.seconds)},
-        {"pine:prep_seconds", float(result.prepSeconds)},
-        {"pine:threads", tbb::this_task_arena::max_concurrency()},
-        {"pine:effects", effects.dump()},
-        {"pine:units", "cm"}});
-    if (!result.treeFoliage.empty()) {
-        metadata.emplace_back(vdbtrace::kTreeFoliageAttribute,
-                              vdbtrace::treeFoliageText(result.treeFoliage));
-    }
-    for (const auto& [key, value] : methodSettings.items()) {
-        if (value.is_number_integer()) {
-            metadata.emplace_back("pine:" + key, value.get<int>());
-        } else if (value.is_number()) {
-            metadata.emplace_back("pine:" + key, value.get<float>());
-        } else if (value.is_string()) {
-            metadata.emplace_back("pine:" + key, value.get<std::string>());
-        } else {
-            metadata.emplace_back("pine:" + key, value.dump());
+    // The law profiles and shadow columns are this rank's: told where one rank rendered all.
+    const auto write = [&](const vdbtrace::RenderResult& result, std::optional<int> f, bool local) {
+        const fs::path exrFile = exrOf(f), stats = statsOf(f);
+        scenes::Camera seen = s.camera;
+        if (f) seen = path.at(*f, still);
+        const vdbtrace::ConeCamera camera(seen);
+        const nlohmann::json methodSettings = method.describe(s, settings);
+        // As compositors and pbrt-v4 read an EXR: render time, samples (pbrt-v4's names) and
+        // OpenEXR's camera matrices, typed; the rest under pine:, numbers as numbers.
+        vdbtrace::Metadata metadata = vdbtrace::cameraMetadata(camera);
+        metadata.insert(metadata.end(), {{"renderTimeSeconds", float(result.seconds)},
+                                         {"samplesPerPixel", method.samplesPerPixel(settings)},
+                                         {"pine:scene", sceneFile.string()},
+                                         {"pine:method", methodName},
+                                         {"pine:render_seconds", float(result.seconds)},
+                                         {"pine:prep_seconds", float(result.prepSeconds)},
+                                         {"pine:threads", tbb::this_task_arena::max_concurrency()},
+                                         {"pine:ranks", ranks.size()},
+                                         {"pine:effects", effects.dump()},
+                                         {"pine:units", "cm"}});
+        if (f) {
+            metadata.emplace_back("pine:frame", *f);
+            metadata.emplace_back("pine:fps", float(path.framesPerSecond));
+            metadata.emplace_back("pine:job", job);
         }
-    }
-    const vdbtrace::Image exr =
-        vdbtrace::exrImage(result.image, camera, method, vdbtrace::EffectsPlan::from(s.effects));
-    // The previews and stats are put in place before the EXR, so that a failure among them
-    // leaves the previous EXR and never a new one beside an old preview. Runs writing into
-    // one folder take turns, so that these files come from one run.
-    const auto writeBeside = [&] {
-        // The preview shows the scene's background behind what the cone did not cover.
-        vdbtrace::writePreviewPng(result.image, s.render.background, besideWith(out, ".png"));
-        for (const std::string& aov : aovs) {
-            if (aov == "level") {
-                vdbtrace::writeLevelPng(result.image, besideWith(out, ".level.png"));
+        if (!result.treeFoliage.empty()) {
+            metadata.emplace_back(vdbtrace::kTreeFoliageAttribute,
+                                  vdbtrace::treeFoliageText(result.treeFoliage));
+        }
+        for (const auto& [key, value] : methodSettings.items()) {
+            if (value.is_number_integer()) {
+                metadata.emplace_back("pine:" + key, value.get<int>());
+            } else if (value.is_number()) {
+                metadata.emplace_back("pine:" + key, value.get<float>());
+            } else if (value.is_string()) {
+                metadata.emplace_back("pine:" + key, value.get<std::string>());
+            } else {
+                metadata.emplace_back("pine:" + key, value.dump());
             }
         }
-        if (!statsFile.empty()) {
-            nlohmann::json j = vdbtrace::toJson(result.stats);
-            j["seconds"] = result.seconds;
-            j["scene"] = sceneFile.string();
-            j["method"] = methodName;
-            j["effects"] = effects;
-            j["resolution"] = {s.camera.width, s.camera.height};
-            if (!frame.crop.empty()) {
-                j["crop"] = {frame.crop.x0, frame.crop.y0, frame.crop.x1, frame.crop.y1};
+        const vdbtrace::Image exr = vdbtrace::exrImage(result.image, camera, method,
+                                                       vdbtrace::EffectsPlan::from(s.effects));
+        // The previews and stats are put in place before the EXR, so that a failure among them
+        // leaves the previous EXR and never a new one beside an old preview; a frame under its
+        // final name is whole. Runs writing into one folder take turns, so that these files
+        // come from one run.
+        const auto writeBeside = [&] {
+            // The preview shows the scene's background behind what the cone did not cover.
+            vdbtrace::writePreviewPng(result.image, s.render.background,
+                                      besideWith(exrFile, ".png"));
+            for (const std::string& aov : aovs) {
+                if (aov == "level") {
+                    vdbtrace::writeLevelPng(result.image, besideWith(exrFile, ".level.png"));
+                }
             }
-            j["threads"] = tbb::this_task_arena::max_concurrency();
-            const auto counted = [](const vdbtrace::ProfileCounts& c) {
-                return nlohmann::json{
-                    {"computed", c.computed}, {"dropped", c.dropped}, {"bytes", c.bytes}};
-            };
-            if (profiles.views.computed + profiles.fromLights.computed > 0) {
-                j["law_profiles"] = {{"views", counted(profiles.views)},
-                                     {"from_lights", counted(profiles.fromLights)},
-                                     {"peak_bytes", profiles.peakBytes}};
+            if (!stats.empty()) {
+                nlohmann::json j = vdbtrace::toJson(result.stats);
+                j["seconds"] = result.seconds;
+                j["scene"] = sceneFile.string();
+                j["method"] = methodName;
+                j["effects"] = effects;
+                j["resolution"] = {s.camera.width, s.camera.height};
+                if (!frame.crop.empty()) {
+                    j["crop"] = {frame.crop.x0, frame.crop.y0, frame.crop.x1, frame.crop.y1};
+                }
+                if (f) j["frame"] = *f;
+                j["threads"] = tbb::this_task_arena::max_concurrency();
+                j["ranks"] = ranks.size();
+                // The law profiles and shadow columns are this rank's: told where it
+                // rendered the whole image.
+                if (local) j.update(kept);
+                j.update(methodSettings);
+                vdbtrace::writeJsonAtomically(j, stats);
             }
-            if (columnsBytes > 0) j["shadow_columns_bytes"] = columnsBytes;
-            j.update(methodSettings);
-            vdbtrace::writeJsonAtomically(j, statsFile);
+        };
+        const io::FolderLock turn(io::FolderLock::of(exrFile), [&] {
+            tool::info() << "vdbtrace: waiting for another run writing into '"
+                         << io::FolderLock::of(exrFile).string() << "'\n";
+        });
+        for (const fs::path& file :
+             {exrFile, besideWith(exrFile, ".png"), besideWith(exrFile, ".level.png")}) {
+            io::removeStaleTemporaries(file);  // a killed run's: live ones wait for the lock
         }
+        vdbtrace::writeExr(exr, exrFile, metadata, writeBeside);
+        const auto& st = result.stats;
+        tool::info() << "vdbtrace: " << exrFile.string() << ": " << result.image.width << "x"
+                     << result.image.height << " in " << result.seconds << " s, " << st.coneRays
+                     << " cone rays, " << st.shadowRays << " shadow rays; pixels by level "
+                     << "needle/cone/bough " << st.pixelsPerLevel[1] << "/" << st.pixelsPerLevel[2]
+                     << "/" << st.pixelsPerLevel[3] << '\n';
     };
-    const io::FolderLock turn(io::FolderLock::of(out), [&] {
-        tool::info() << "vdbtrace: waiting for another run writing into '"
-                     << io::FolderLock::of(out).string() << "'\n";
-    });
-    for (const fs::path& file : {out, besideWith(out, ".png"), besideWith(out, ".level.png")}) {
-        io::removeStaleTemporaries(file);  // a killed run's: live ones wait for the lock
+
+    const vdbtrace::PixelWindow whole =
+        frame.crop.empty() ? vdbtrace::PixelWindow{0, 0, s.camera.width, s.camera.height}
+                           : frame.crop;
+    const int rankCount = ranks.size(), me = ranks.rank();
+    const std::vector<std::optional<int>> images =
+        animation ? std::vector<std::optional<int>>(toRender.begin(), toRender.end())
+                  : std::vector<std::optional<int>>{std::nullopt};
+    if (rankCount > 1 && images.size() == 1) {
+        // One image, many ranks: bands of whole tile rows, put together by the leader.
+        const auto bands = vdbtrace::rowBands(whole, rankCount, vdbtrace::RenderOptions().tileSize);
+        std::optional<vdbtrace::RenderResult> mine;
+        if (std::size_t(me) < bands.size()) {
+            mine = renderAt(images[0], bands[std::size_t(me)], true);
+        }
+        if (!leader && mine) ranks.send(0, vdbtrace::packRender(*mine));
+        if (leader) {
+            std::vector<vdbtrace::RenderResult> bandRenders;
+            bandRenders.push_back(std::move(*mine));
+            for (std::size_t q = 1; q < bands.size(); ++q) {
+                bandRenders.push_back(vdbtrace::unpackRender(ranks.receive(int(q))));
+            }
+            write(vdbtrace::joinBands(std::move(bandRenders), bands, whole), images[0], false);
+        }
+    } else {
+        // Frames dealt round-robin (a dolly's near and far frames spread over the ranks), one
+        // round at a time: the leader writes its own, then each other rank's as it arrives.
+        for (std::size_t round = 0; round < images.size(); round += std::size_t(rankCount)) {
+            const std::size_t mine = round + std::size_t(me);
+            std::optional<vdbtrace::RenderResult> result;
+            if (mine < images.size()) {
+                result = renderAt(images[mine], frame.crop,
+                                  mine + std::size_t(rankCount) >= images.size());
+            }
+            if (!leader && result) ranks.send(0, vdbtrace::packRender(*result));
+            if (!leader) continue;
+            write(*result, images[mine], rankCount == 1);
+            for (int q = 1; q < rankCount && round + std::size_t(q) < images.size(); ++q) {
+                write(vdbtrace::unpackRender(ranks.receive(q)), images[round + std::size_t(q)],
+                      false);
+            }
+        }
     }
-    vdbtrace::writeExr(exr, out, metadata, writeBeside);
-    const auto& st = result.stats;
-    tool::info() << "vdbtrace: " << out.string() << ": " << result.image.width << "x"
-                 << result.image.height << " in " << result.seconds << " s, " << st.coneRays
-                 << " cone rays, " << st.shadowRays << " shadow rays; pixels by level "
-                 << "needle/cone/bough " << st.pixelsPerLevel[1] << "/" << st.pixelsPerLevel[2]
-                 << "/" << st.pixelsPerLevel[3] << '\n';
+    // Every rank's CPU time, summed: what the frames cost the machines.
+    const double cpuSeconds = ranks.sum(io::processCpuSeconds());
+    if (leader && (animation || rankCount > 1)) {
+        const double wall = std::chrono::duration<double>(Clock::now() - started).count();
+        const char* what = animation ? (images.size() == 1 ? " frame" : " frames") : " image";
+        tool::info() << "vdbtrace: " << images.size() << what << " in " << wall << " s, "
+                     << cpuSeconds << " CPU-s on " << rankCount
+                     << (rankCount == 1 ? " rank" : " ranks") << " ("
+                     << double(images.size()) / cpuSeconds << " per CPU-second)\n";
+    }
     return 0;
+}
+
+/// `body` on every rank of `ranks`. Alone, as any command. Under mpirun: the ranks on one
+/// machine share its cores (each takes its share unless --threads says), only the leader
+/// speaks of progress, and an error on any rank ends the whole job at once, naming the rank
+/// (the others would wait for it for ever).
+int renderOnRanks(vdbtrace::Ranks& ranks, CLI::App& app, const std::function<int()>& body)
+{
+    if (ranks.size() == 1) return body();
+    std::unique_ptr<tbb::global_control> share;
+    if (app.get_option("--threads")->count() == 0) {
+        const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
+        share = std::make_unique<tbb::global_control>(
+            tbb::global_control::max_allowed_parallelism,
+            std::size_t(std::max(1, cores / ranks.sizeOnThisMachine())));
+    }
+    if (ranks.rank() != 0) tool::setQuiet(true);
+    const auto fail = [&](const std::string& what, int status) {
+        tool::Progress::endOpenLine();
+        std::cerr << "vdbtrace: rank " << ranks.rank() << " of " << ranks.size() << ": " << what
+                  << " (ending the job)\n";
+        ranks.abort(status);
+    };
+    try {
+        return body();
+    } catch (const InputError& e) {
+        fail(e.what(), 2);
+    } catch (const std::bad_alloc&) {
+        fail("out of memory", 2);
+    } catch (const std::exception& e) {
+        fail(e.what(), 1);
+    }
+    return 1;  // fail() does not return
 }
 
 std::string machineDescription();
@@ -934,6 +1169,14 @@ void addNeedlePrimitive(CLI::App& cmd, vdbtrace::NeedlePrimitive& primitive)
 
 int main(int argc, char** argv)
 {
+    // Before any thread: under mpirun, MPI starts here (ranks.h); alone, one rank.
+    std::unique_ptr<vdbtrace::Ranks> ranks;
+    try {
+        ranks = vdbtrace::jobRanks(argc, argv);
+    } catch (const std::exception& e) {
+        std::cerr << "vdbtrace: " << e.what() << '\n';
+        return 2;
+    }
     CLI::App app{"vdbtrace: the cone tracer of Meyer & Neyret's multiscale pine shaders"};
     app.require_subcommand(1);
 
@@ -985,6 +1228,12 @@ int main(int argc, char** argv)
             return parseCrop(text, w) ? std::string()
                                       : "expected x0,y0,x1,y1 with 0 <= x0 < x1 and 0 <= y0 < y1";
         });
+    std::string framesText;
+    renderCmd->add_option("--frames", framesText,
+                          "Render frames A-B (or A) of the scene's camera_path as OUT.####.exr "
+                          "(+ previews); frames this job already rendered are kept, so an "
+                          "interrupted job resumes. Under mpirun the frames are dealt over the "
+                          "ranks; one image alone is cut into bands of rows");
     addMaxMemory(*renderCmd, maxMemoryGiB, "a render");
     renderCmd->add_option("--aov", aovs, "Extra images: 'level' (Figure 12 false colours)")
         ->check(CLI::IsMember({"level"}));
@@ -1125,8 +1374,17 @@ int main(int argc, char** argv)
                 vdbtrace::parseResolution(renderResolution, frame.width, frame.height);
             }
             if (!crop.empty()) parseCrop(crop, frame.crop);
-            return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles, model,
-                          frame, maxMemoryGiB, lawCacheMiB);
+            std::optional<vdbtrace::FrameRange> frames;
+            if (!framesText.empty()) frames = vdbtrace::parseFrameRange(framesText);
+            return renderOnRanks(*ranks, app, [&] {
+                return render(sceneFile, method, out, statsFile, aovs, settings, gridFiles, model,
+                              frame, maxMemoryGiB, lawCacheMiB, frames, *ranks);
+            });
+        }
+        if (ranks->size() > 1) {
+            throw InputError(
+                "only render splits its work over mpirun's ranks: run the other "
+                "commands as one process");
         }
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
         if (*compareCmd) {

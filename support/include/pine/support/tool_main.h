@@ -19,6 +19,8 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
 
 /// True under --quiet (which run adds to every tool).
 bool quiet();
+/// As --quiet would: a process whose progress another one tells (an MPI rank's).
+void setQuiet(bool quiet);
 /// Where informational lines go: stderr, or nowhere under --quiet. Warnings and errors go to
 /// std::cerr whatever the flag.
 std::ostream& info();

@@ -1,0 +1,96 @@
+// The MPI module (ranks.h): Open MPI's C interface behind Ranks. Only the main thread calls
+// MPI (MPI_THREAD_FUNNELED); the renders' TBB workers never do.
+#include "pine/vdbtrace/ranks.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <climits>
+#include <cstdlib>
+
+namespace pine::vdbtrace {
+namespace {
+
+// A message longer than MPI's int count goes in pieces of this many bytes.
+constexpr std::size_t kPiece = std::size_t(1) << 30;
+constexpr int kSizeTag = 1, kPieceTag = 2;
+
+class MpiRanks final : public Ranks {
+public:
+    MpiRanks(int* argc, char*** argv)
+    {
+        int provided = 0;
+        MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+        MPI_Comm_rank(MPI_COMM_WORLD, &mRank);
+        MPI_Comm_size(MPI_COMM_WORLD, &mSize);
+        MPI_Comm local;
+        MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, mRank, MPI_INFO_NULL, &local);
+        MPI_Comm_size(local, &mLocalSize);
+        MPI_Comm_free(&local);
+    }
+    ~MpiRanks() override { MPI_Finalize(); }
+
+    int rank() const override { return mRank; }
+    int size() const override { return mSize; }
+    int sizeOnThisMachine() const override { return mLocalSize; }
+
+    void send(int to, const Bytes& bytes) override
+    {
+        unsigned long long size = bytes.size();
+        MPI_Send(&size, 1, MPI_UNSIGNED_LONG_LONG, to, kSizeTag, MPI_COMM_WORLD);
+        for (std::size_t at = 0; at < bytes.size(); at += kPiece) {
+            const int count = int(std::min(kPiece, bytes.size() - at));
+            MPI_Send(bytes.data() + at, count, MPI_BYTE, to, kPieceTag, MPI_COMM_WORLD);
+        }
+    }
+
+    Bytes receive(int from) override
+    {
+        unsigned long long size = 0;
+        MPI_Recv(&size, 1, MPI_UNSIGNED_LONG_LONG, from, kSizeTag, MPI_COMM_WORLD,
+                 MPI_STATUS_IGNORE);
+        Bytes bytes(size);
+        for (std::size_t at = 0; at < bytes.size(); at += kPiece) {
+            const int count = int(std::min(kPiece, bytes.size() - at));
+            MPI_Recv(bytes.data() + at, count, MPI_BYTE, from, kPieceTag, MPI_COMM_WORLD,
+                     MPI_STATUS_IGNORE);
+        }
+        return bytes;
+    }
+
+    void broadcast(Bytes& bytes, int root) override
+    {
+        unsigned long long size = bytes.size();
+        MPI_Bcast(&size, 1, MPI_UNSIGNED_LONG_LONG, root, MPI_COMM_WORLD);
+        bytes.resize(size);
+        for (std::size_t at = 0; at < bytes.size(); at += kPiece) {
+            const int count = int(std::min(kPiece, bytes.size() - at));
+            MPI_Bcast(bytes.data() + at, count, MPI_BYTE, root, MPI_COMM_WORLD);
+        }
+    }
+
+    double sum(double value) override
+    {
+        double total = 0.0;
+        MPI_Allreduce(&value, &total, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+        return total;
+    }
+
+    [[noreturn]] void abort(int status) override
+    {
+        MPI_Abort(MPI_COMM_WORLD, status);
+        std::exit(status);  // MPI_Abort does not return; this tells the compiler so
+    }
+
+private:
+    int mRank = 0, mSize = 1, mLocalSize = 1;
+};
+
+}  // namespace
+}  // namespace pine::vdbtrace
+
+extern "C" __attribute__((visibility("default"))) pine::vdbtrace::Ranks* pine_mpi_ranks(
+    int* argc, char*** argv)
+{
+    return new pine::vdbtrace::MpiRanks(argc, argv);
+}
