@@ -391,7 +391,29 @@ grep -q "the image module libpine_image_codec.so is missing" "$work/alone/err" |
     fail "a missing image module: $(tail -1 "$work/alone/err")"
 grep -q "rendering" "$work/alone/err" && fail "a missing image module is found after the render"
 [ -e "$work/alone/a.exr" ] && fail "a missing image module left an image"
+# Animations: frames need a camera path, at least 3 for the temporal report.
+expect_error "frames without a path" 2 "has no camera_path" -- render "$src/scenes/bough.json" --frames 1-3 --out "$work/f.exr"
+expect_error "bad frame range" 2 "expected A-B" -- render "$src/scenes/three-firs.json" --frames 5-2 --out "$work/f.exr"
+expect_error "temporal report without a path" 2 "has no camera_path" -- animate-compare "$src/scenes/bough.json" --out-dir "$work/anim"
+expect_error "temporal report of 2 frames" 2 "at least 3 frames" -- animate-compare "$src/scenes/three-firs.json" --frames 1-2 --self-shadowing --out-dir "$work/anim"
+expect_error "temporal report, effects unmatched" 2 "self_shadowing" -- animate-compare "$src/scenes/paper-forest.json" --out-dir "$work/anim"
+"$vdbtrace" animate-compare "$src/scenes/three-firs.json" --frames 2-5 --resolution 32x24 \
+    --self-shadowing --strip 2 --no-plot --out-dir "$work/anim" --quiet || fail "animate-compare: exit $?"
+for f in report.md flicker.csv frames.csv strip.png; do
+    [ -s "$work/anim/$f" ] || fail "animate-compare wrote no $f"
+done
+# 3 methods x (all pixels + 4 bands), and 4 frames each.
+[ "$(tail -n +2 "$work/anim/flicker.csv" | wc -l)" -eq 15 ] || fail "flicker.csv: $(cat "$work/anim/flicker.csv")"
+[ "$(grep -c '^[2-5],' "$work/anim/frames.csv")" -eq 12 ] || fail "frames.csv: $(cat "$work/anim/frames.csv")"
+mkdir -p "$work/seq"
+"$vdbtrace" render "$src/scenes/three-firs.json" --frames 2-4 --resolution 32x24 --quiet \
+    --out "$work/seq/f.exr" || fail "render --frames: exit $?"
+for f in 0002 0003 0004; do
+    [ -s "$work/seq/f.$f.exr" ] && [ -s "$work/seq/f.$f.png" ] || fail "render --frames wrote no frame $f"
+done
+[ -e "$work/seq/f.exr" ] && fail "render --frames also wrote the unnumbered name"
 "$vdbtrace" render --help >/dev/null || fail "render --help"
+"$vdbtrace" animate-compare --help >/dev/null || fail "animate-compare --help"
 "$vdbtrace" bench --help >/dev/null || fail "bench --help"
 
 echo "vdbtrace cli: $failures failed"

@@ -1,7 +1,6 @@
 #include "pine/vdbtrace/dolly.h"
 
-#include "pine/vdbtrace/flicker.h"
-#include "pine/vdbtrace/methods.h"
+#include "pine/vdbtrace/animation_flicker.h"
 
 #include <algorithm>
 
@@ -11,36 +10,25 @@ DollyFlicker measureDollyFlicker(const scenes::Scene& base, const CompareSetting
                                  const CompareLog& log)
 {
     DollyFlicker out;
-    scenes::Scene scene = base;
-    out.width = scene.camera.width = std::max(8, base.camera.width / s.frameDivisor);
-    out.height = scene.camera.height = std::max(8, base.camera.height / s.frameDivisor);
-    const scenes::Vec3 offset = base.camera.position_cm - base.camera.lookAt_cm;
-    struct Sequence {
-        const char* label;
-        const char* method;
-        int samples;
-    };
-    const Sequence sequences[] = {
-        {"multiscale_auto", "multiscale", 0}, {"geometry_1spp", "geometry", 1},
-        {"geometry_4spp", "geometry", 4}};
-    std::vector<std::vector<Image>> frames(std::size(sequences));
-    for (const Sequence& q : sequences) out.rows.push_back({q.label});
+    scenes::Camera still = base.camera;
+    out.width = still.width = std::max(8, base.camera.width / s.frameDivisor);
+    out.height = still.height = std::max(8, base.camera.height / s.frameDivisor);
+    // The camera backs away from its look-at, to dollyEnd times its distance.
+    const scenes::Vec3 offset = still.position_cm - still.lookAt_cm;
+    std::vector<scenes::Camera> cameras;
     for (int f = 0; f < s.frames; ++f) {
         const double t = s.frames > 1 ? double(f) / double(s.frames - 1) : 0.0;
-        scene.camera.position_cm = base.camera.lookAt_cm + offset * (1.0 + (s.dollyEnd - 1.0) * t);
-        const TracedScene traced = buildTracedScene(scene);
-        for (std::size_t m = 0; m < std::size(sequences); ++m) {
-            MethodSettings settings;
-            settings.geometry.samples = std::max(1, sequences[m].samples);
-            RenderResult r = renderMethod(sequences[m].method).render(traced, settings, {});
-            out.rows[m].secondsPerFrame += r.seconds / double(s.frames);
-            r.image.aovs.clear();  // only RGB is measured; 16 frames of AOVs would be memory
-            frames[m].push_back(std::move(r.image));
-        }
-        if (log) log("dolly frame " + std::to_string(f + 1) + "/" + std::to_string(s.frames));
+        scenes::Camera c = still;
+        c.position_cm = still.lookAt_cm + offset * (1.0 + (s.dollyEnd - 1.0) * t);
+        cameras.push_back(c);
     }
-    for (std::size_t m = 0; m < out.rows.size(); ++m)
-        out.rows[m].flicker = temporalFlicker(frames[m]);
+    const AnimationFlicker measured =
+        measureAnimationFlicker(base, cameras, {}, 0, [&log](const std::string& line) {
+            if (log) log("dolly " + line);
+        });
+    for (const AnimationRow& row : measured.rows) {
+        out.rows.push_back({row.method, row.flicker.flicker, row.secondsPerFrame});
+    }
     return out;
 }
 

@@ -11,6 +11,7 @@
 #include "pine/support/process_clock.h"
 #include "pine/support/progress.h"
 #include "pine/support/tool_main.h"
+#include "pine/vdbtrace/animation_report.h"
 #include "pine/vdbtrace/compare.h"
 #include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/exr_output.h"
@@ -1360,6 +1361,32 @@ int main(int argc, char** argv)
     addMaxMemory(*compareCmd, maxMemoryGiB, "a comparison");
     model.add(*compareCmd);
 
+    vdbtrace::AnimationCompareOptions animate;
+    std::string animateFrames, animateResolution;
+    bool animateNoPlot = false;
+    auto* animateCmd = app.add_subcommand(
+        "animate-compare",
+        "The scene's camera path rendered by multiscale and by geometry at 1 and 4 spp: "
+        "flicker per method and per level band, over the frames, and a strip of frames "
+        "(report.md, flicker.csv, frames.csv, flicker_frames.png, strip.png)");
+    animateCmd->add_option("scene", animate.sceneFile, "Scene file (JSON) with a camera_path")
+        ->required();
+    animateCmd->add_option("--out-dir", animate.outDir, "Folder for the report")->required();
+    animateCmd->add_option("--frames", animateFrames,
+                           "Frames A-B of the path (default: the path's own; at least 3)");
+    addResolution(*animateCmd, animateResolution,
+                  "WxH instead of the camera's (same view, vertical field kept)", "320x240");
+    animateCmd->add_option("--strip", animate.stripFrames, "Frames shown in strip.png")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 16));
+    animateCmd->add_flag("--self-shadowing", animate.addSelfShadowing,
+                         "Add self_shadowing where the scene's effects name shadows (the "
+                         "explicit needles always self-shadow; a scene with shadows alone is "
+                         "refused without it)");
+    animateCmd->add_flag("--no-plot", animateNoPlot, "Skip flicker_frames.png");
+    addMaxMemory(*animateCmd, maxMemoryGiB, "a temporal comparison");
+    model.add(*animateCmd);
+
     return tool::run("vdbtrace", app, argc, argv, [&] {
         if (*renderCmd) {
             // An option of another method would be ignored: refused, so that no one believes
@@ -1387,6 +1414,26 @@ int main(int argc, char** argv)
                 "commands as one process");
         }
         if (*diffCmd) return diff(diffA, diffB, diffOut, diffScale);
+        if (*animateCmd) {
+            if (!animateFrames.empty()) animate.frames = vdbtrace::parseFrameRange(animateFrames);
+            if (!animateResolution.empty()) {
+                vdbtrace::parseResolution(animateResolution, animate.width, animate.height);
+            }
+            animate.maxMemoryBytes = bake::memoryLimit(maxMemoryGiB);
+            animate.machine = machineDescription();
+            animate.model = [&model](scenes::ModelChoices& m) { model.apply(m); };
+            animate.log = [](const std::string& line) {
+                tool::info() << "vdbtrace animate-compare: " << line << '\n';
+            };
+            if (!animateNoPlot) {
+                animate.plot = [](const fs::path& dir) {
+                    return tool::runPlotScript(tool::plotScript("plot_animation.py"), dir) &&
+                           fs::exists(dir / "flicker_frames.png");
+                };
+            }
+            vdbtrace::runAnimationCompare(animate);
+            return 0;
+        }
         if (*compareCmd) {
             compare.settings = vdbtrace::CompareSettings::forQuick(quick);
             if (truthSamples > 0) compare.settings.truthSamples = truthSamples;

@@ -1,0 +1,225 @@
+#include "pine/vdbtrace/animation_report.h"
+
+#include "pine/bake/resource_estimate.h"
+#include "pine/support/atomic_file.h"
+#include "pine/support/input_error.h"
+#include "pine/vdbtrace/preview.h"
+
+#include <algorithm>
+#include <chrono>
+#include <iomanip>
+#include <sstream>
+
+namespace pine::vdbtrace {
+namespace {
+
+// A path's pixels change along curves (a trunk sweeping across them): each frame is measured
+// against its neighbours' line (flicker.h).
+constexpr int kPathWindow = 3;
+
+std::string flickerCsv(const AnimationFlicker& a)
+{
+    std::ostringstream csv;
+    csv << "method,band,pixels,flicker,seconds_per_frame,cpu_seconds_per_frame\n"
+        << std::setprecision(6);
+    for (const AnimationRow& r : a.rows) {
+        csv << r.method << ",all," << std::size_t(a.width) * a.height << ',' << r.flicker.flicker
+            << ',' << r.secondsPerFrame << ',' << r.cpuSecondsPerFrame << '\n';
+        for (std::size_t b = 0; b < r.flicker.perBand.size(); ++b) {
+            csv << r.method << ',' << kLevelBandKeys[b] << ',' << r.flicker.bandPixels[b] << ','
+                << r.flicker.perBand[b] << ',' << r.secondsPerFrame << ',' << r.cpuSecondsPerFrame
+                << '\n';
+        }
+    }
+    return csv.str();
+}
+
+std::string framesCsv(const AnimationFlicker& a, const std::vector<int>& frameNumbers)
+{
+    std::ostringstream csv;
+    csv << "frame,method,residual_rms,mean_luminance\n" << std::setprecision(6);
+    for (const AnimationRow& r : a.rows) {
+        for (std::size_t t = 0; t < frameNumbers.size(); ++t) {
+            csv << frameNumbers[t] << ',' << r.method << ',' << r.flicker.residualPerFrame[t] << ','
+                << r.flicker.luminancePerFrame[t] << '\n';
+        }
+    }
+    return csv.str();
+}
+
+// Each row's kept frames side by side, one row of frames per method, a 2-pixel gap of the
+// background between them.
+Image strip(const AnimationFlicker& a)
+{
+    constexpr int gap = 2;
+    const int columns = int(a.rows.front().kept.size());
+    const int rows = int(a.rows.size());
+    Image out(columns * a.width + (columns - 1) * gap, rows * a.height + (rows - 1) * gap);
+    for (int r = 0; r < rows; ++r) {
+        for (int c = 0; c < columns; ++c) {
+            const Image& frame = a.rows[std::size_t(r)].kept[std::size_t(c)];
+            for (int y = 0; y < a.height; ++y) {
+                std::copy_n(frame.pixel(0, y), 4 * a.width,
+                            out.pixel(c * (a.width + gap), r * (a.height + gap) + y));
+            }
+        }
+    }
+    return out;
+}
+
+std::string number(double v, int digits = 3)
+{
+    std::ostringstream s;
+    s << std::setprecision(digits) << v;
+    return s.str();
+}
+
+std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o,
+                     const scenes::Scene& scene, const std::vector<int>& frameNumbers,
+                     const std::vector<int>& stripFrames, bool plotted)
+{
+    std::ostringstream md;
+    md << "# Temporal report: " << o.sceneFile.filename().string() << "\n\n"
+       << "The scene's camera path, frames " << frameNumbers.front() << "-" << frameNumbers.back()
+       << " (" << frameNumbers.size() << " frames, " << number(scene.cameraPath.framesPerSecond)
+       << " per second), " << a.width << " x " << a.height
+       << ", rendered by each method with the same effects ("
+       << (scene.effects.shadows ? "shadows and self-shadowing" : "no shadows")
+       << "). Machine: " << o.machine << ".\n\n"
+       << "**Flicker** is, for each pixel, how far its luminance at each frame departs from "
+       << "the line through its two neighbouring frames, l(t) - (l(t-1) + l(t+1)) / 2, as a "
+       << "root mean square over the frames divided by sqrt(1.5): for frames that jitter "
+       << "independently it is their standard deviation, and any motion linear over three "
+       << "frames counts for nothing; averaged over the pixels "
+       << "(`vdbtrace/include/pine/vdbtrace/flicker.h`). Edges sweeping across pixels still "
+       << "count, alike for every method; what differs between methods is their aliasing. "
+       << "A band's flicker is the same mean over "
+       << "the pixels of that band: a pixel's band is the level the multiscale render shades "
+       << "it at, averaged over the frames with foliage there; the bands are the same pixels "
+       << "for every method.\n\n";
+    md << "| method | flicker, all pixels |";
+    for (const char* band : kLevelBandNames) md << ' ' << band << " |";
+    md << " render s / frame | CPU-s / frame |\n|---|---|";
+    for (std::size_t b = 0; b < std::size(kLevelBandNames); ++b) md << "---|";
+    md << "---|---|\n";
+    for (const AnimationRow& r : a.rows) {
+        md << "| " << r.method << " | " << number(r.flicker.flicker) << " |";
+        for (std::size_t b = 0; b < r.flicker.perBand.size(); ++b) {
+            md << ' '
+               << (r.flicker.bandPixels[b] > 0 ? number(r.flicker.perBand[b]) : std::string("-"))
+               << " |";
+        }
+        md << ' ' << number(r.secondsPerFrame) << " | " << number(r.cpuSecondsPerFrame) << " |\n";
+    }
+    md << "| pixels in the band | " << std::size_t(a.width) * a.height << " |";
+    for (const std::size_t n : a.rows.front().flicker.bandPixels) md << ' ' << n << " |";
+    md << " | |\n\n";
+    const AnimationRow& ms = a.rows.front();
+    for (std::size_t m = 1; m < a.rows.size(); ++m) {
+        md << "- " << a.rows[m].method << " flickers "
+           << number(a.rows[m].flicker.flicker / std::max(ms.flicker.flicker, 1e-30))
+           << " times as much as " << ms.method << ".\n";
+    }
+    md << "\n## Over the frames\n\n"
+       << "Each frame's departure from the pixels' lines (root mean square over the pixels, "
+       << "`frames.csv`): a frame that pops, a level switching over a whole tree, stands out "
+       << "as a spike; a steady method stays flat.\n\n";
+    if (plotted) {
+        md << "![flicker over the frames](flicker_frames.png)\n\n";
+    } else {
+        md << "(No plot: matplotlib was not available or failed; frames.csv has the data.)\n\n";
+    }
+    md << "## Frames\n\n![frames](strip.png)\n\nRows: ";
+    for (std::size_t m = 0; m < a.rows.size(); ++m) {
+        md << (m ? ", " : "") << a.rows[m].method;
+    }
+    md << "; columns: frames";
+    for (std::size_t k = 0; k < stripFrames.size(); ++k) {
+        md << (k ? ", " : " ") << frameNumbers[std::size_t(stripFrames[k])];
+    }
+    md << ".\n\nRegenerate: `vdbtrace animate-compare " << o.sceneFile.string()
+       << " --out-dir DIR --resolution " << a.width << "x" << a.height
+       << (o.addSelfShadowing ? " --self-shadowing" : "") << "`.\n";
+    return md.str();
+}
+
+}  // namespace
+
+AnimationFlicker runAnimationCompare(const AnimationCompareOptions& o)
+{
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    const auto log = [&](const std::string& line) {
+        if (o.log) o.log(line);
+    };
+    io::checkWritableFolder(o.outDir);
+    loadImageIo();
+    scenes::Scene scene = scenes::loadScene(o.sceneFile);
+    if (o.model) o.model(scene.render.model);
+    if (o.addSelfShadowing) scene.effects.selfShadowing |= scene.effects.shadows;
+    checkEffects(scene.effects);
+    if (scene.cameraPath.empty()) {
+        throw InputError("'" + o.sceneFile.string() +
+                         "' has no camera_path to compare the methods along "
+                         "(docs/scene-format.md)");
+    }
+    if (o.width > 0 && o.height > 0) {
+        scene.camera.width = o.width;
+        scene.camera.height = o.height;
+    }
+    const FrameRange range =
+        o.frames ? *o.frames : FrameRange{scene.cameraPath.firstFrame, scene.cameraPath.lastFrame};
+    if (range.count() < 3) {
+        throw InputError("flicker needs at least 3 frames; frames " + std::to_string(range.first) +
+                         "-" + std::to_string(range.last) + " are " +
+                         std::to_string(range.count()));
+    }
+    std::vector<int> frameNumbers;
+    std::vector<scenes::Camera> cameras;
+    for (int f = range.first; f <= range.last; ++f) {
+        frameNumbers.push_back(f);
+        cameras.push_back(scene.cameraPath.at(f, scene.camera));
+    }
+    // Evenly spaced from the first frame to the last.
+    std::vector<int> stripFrames;
+    const int shown = std::clamp(o.stripFrames, 1, range.count());
+    for (int k = 0; k < shown; ++k) {
+        stripFrames.push_back(shown == 1 ? 0 : k * (range.count() - 1) / (shown - 1));
+    }
+    if (o.maxMemoryBytes > 0.0) {
+        // The heavier method's render, plus every frame of every sequence held for the flicker.
+        bake::ResourceEstimate needs = bake::estimateRender(scene, "geometry", 1.0);
+        const double frameBytes = double(scene.camera.width) * scene.camera.height * 16.0;
+        needs.parts.push_back(
+            {std::to_string(range.count()) + " frames x " +
+                 std::to_string(std::size(kAnimationSequences)) + " methods held",
+             frameBytes * range.count() * (double(std::size(kAnimationSequences)) + 0.25)});
+        bake::checkMemory(needs, o.maxMemoryBytes, o.sceneFile.string());
+    }
+    log(o.sceneFile.string() + ": " + std::to_string(range.count()) + " frames at " +
+        std::to_string(scene.camera.width) + " x " + std::to_string(scene.camera.height) + ", " +
+        std::to_string(std::size(kAnimationSequences)) + " methods");
+    const AnimationFlicker a =
+        measureAnimationFlicker(scene, cameras, stripFrames, kPathWindow, log);
+
+    io::writeTextAtomically(o.outDir / "flicker.csv", flickerCsv(a));
+    io::writeTextAtomically(o.outDir / "frames.csv", framesCsv(a, frameNumbers));
+    writePreviewPng(strip(a), scene.render.background, o.outDir / "strip.png");
+    bool plotted = false;
+    if (o.plot) {
+        plotted = o.plot(o.outDir);
+        if (!plotted) log("warning: plotting failed (frames.csv has the data)");
+    }
+    io::writeTextAtomically(o.outDir / "report.md",
+                            reportMd(a, o, scene, frameNumbers, stripFrames, plotted));
+    std::string summary = std::to_string(range.count()) + " frames x " +
+                          std::to_string(a.rows.size()) + " methods in " +
+                          number(std::chrono::duration<double>(Clock::now() - start).count()) +
+                          " s; flicker";
+    for (const AnimationRow& r : a.rows)
+        summary += " " + r.method + " " + number(r.flicker.flicker);
+    log(summary);
+    return a;
+}
+
+}  // namespace pine::vdbtrace
