@@ -36,7 +36,7 @@ TEST(FlickerBreakdown, TheWholeLineIsTemporalFlickerAndARampIsSteady)
     std::mt19937 rng(3);
     std::normal_distribution<double> noise(0.0, 0.05);
     const auto noisy =
-        sequence(16, 8, 9, [&](int i, int t) { return 0.3 + 0.01 * i + noise(rng); });
+        sequence(16, 8, 9, [&](int i, int) { return 0.3 + 0.01 * i + noise(rng); });
     EXPECT_DOUBLE_EQ(flickerBreakdown(noisy).flicker, temporalFlicker(noisy));
     const auto ramp = sequence(16, 8, 9, [](int i, int t) { return 0.1 + 0.002 * i * t; });
     EXPECT_NEAR(flickerBreakdown(ramp, {}, 1, 0).flicker, 0.0, 1e-6);
