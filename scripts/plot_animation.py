@@ -5,7 +5,8 @@ Usage: MPLBACKEND=Agg /usr/bin/python3 scripts/plot_animation.py DIR
 
 Reads DIR/frames.csv (frame, method, residual_rms, mean_luminance) and writes
 DIR/flicker_frames.png (atomically, via DIR/flicker_frames.png.tmp.png): above, each method's
-departure from the pixels' lines frame by frame (a frame that pops is a spike); below, each
+departure from the pixels' lines frame by frame (a frame that pops is a spike; "nan" where a
+frame has none to tell, the path's first and last, is left out of the line); below, each
 method's mean luminance (the scene's change along the path, which the lines remove).
 """
 import csv

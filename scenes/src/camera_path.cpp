@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <numbers>
+#include <sstream>
 
 namespace pine::scenes {
 namespace {
@@ -71,6 +73,21 @@ Camera CameraPath::at(double frame, const Camera& still) const
     const double upLength = glm::length(c.up);
     if (upLength > 0.0) c.up /= upLength;
     return c;
+}
+
+std::string cameraProblem(const Camera& c)
+{
+    const Vec3 view = c.lookAt_cm - c.position_cm;
+    if (!(glm::length(view) > 0.0)) return "look_at equals position (no view direction)";
+    if (!(glm::length(glm::cross(glm::normalize(view), c.up)) >= 1e-6)) {
+        return "up is parallel to the view direction (or zero)";
+    }
+    if (!(c.fovY_rad > 0.0 && c.fovY_rad < std::numbers::pi)) {
+        std::ostringstream fov;
+        fov << "fov_deg " << c.fovY_rad * 180.0 / std::numbers::pi << " is outside (0, 180)";
+        return fov.str();
+    }
+    return {};
 }
 
 const char* interpolationName(CameraPath::Interpolation interpolation)

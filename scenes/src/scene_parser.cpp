@@ -51,21 +51,6 @@ Camera readCamera(const Json& value, const Where& where)
     return c;
 }
 
-// Why a camera cannot render, or empty: the checks a still camera's keys get, for any camera
-// a path passes through.
-std::string cameraProblem(const Camera& c)
-{
-    const Vec3 view = c.lookAt_cm - c.position_cm;
-    if (!(glm::length(view) > 0.0)) return "look_at equals position (no view direction)";
-    if (!(glm::length(glm::cross(glm::normalize(view), c.up)) >= 1e-6)) {
-        return "up is parallel to the view direction (or zero)";
-    }
-    if (!(c.fovY_rad > 0.0 && c.fovY_rad < std::numbers::pi)) {
-        return "fov_deg " + detail::formatNumber(c.fovY_rad / kRadPerDeg) + " is outside (0, 180)";
-    }
-    return {};
-}
-
 constexpr long long kMaxFrame = 9999999;
 constexpr long long kMaxFrames = 100000;
 

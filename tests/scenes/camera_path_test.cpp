@@ -65,6 +65,14 @@ TEST(CameraPath, PassesThroughEveryKeyAndHoldsBeyondTheEnds)
             EXPECT_LT(glm::length(c.lookAt_cm - key.lookAt_cm), 1e-9);
             EXPECT_NEAR(c.fovY_rad, key.fovY_rad, 1e-12);
         }
+        for (const double f :
+             {path.keys.front().frame - 3.0, 0.5 * (path.keys[1].frame + path.keys[2].frame),
+              path.keys.back().frame + 3.0}) {
+            EXPECT_NEAR(glm::length(path.at(f, still).up), 1.0, 1e-12) << "frame " << f;
+        }
+        EXPECT_LT(
+            glm::length(path.at(path.keys.back().frame + 3.0, still).up - path.keys.back().up),
+            1e-12);
         const Camera before = path.at(path.keys.front().frame - 10.0, still);
         const Camera after = path.at(path.keys.back().frame + 10.0, still);
         EXPECT_EQ(before.position_cm, path.keys.front().position_cm);
@@ -169,7 +177,9 @@ TEST(CameraPath, BadPathsAreRefusedNamingTheKeyOrTheFrame)
             "more than 100000");
     refused(R"({"keys": [{"frame": 1}], "interpolation": "cubic"})", "camera_path.interpolation",
             "\"smooth\" or \"linear\"");
-    refused(R"({"keys": [{"frame": 1, "fov_deg": "NaN"}]})", "camera_path.keys[0].fov_deg", "");
+    refused(R"({"keys": [{"frame": 1, "fov_deg": 0}]})", "camera_path.keys[0].fov_deg",
+            "must be in (0, 180)");
+    refused(R"({"keys": [{"frame": 1, "up": [0, 0, 0]}]})", "camera_path.keys[0].up", "");
     // The look-at reaches the camera between keys.
     refused(R"({"keys": [{"frame": 0, "position": [0, -10, 100], "look_at": [0, 10, 100]},
                          {"frame": 10, "position": [0, 10, 100], "look_at": [0, -10, 100]}],

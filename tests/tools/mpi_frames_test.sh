@@ -47,6 +47,19 @@ mpi 2 render "$scene" "${small[@]}" --frames 3 --out "$work/band/f.exr" --method
     --samples 2 || fail "geometry frame: exit $?"
 same "$work/one/g.0003.exr" "$work/band/f.0003.exr"
 
+# Fewer tile rows than ranks (2 bands, 3 ranks), and fewer frames than ranks (2 frames, 3).
+"$tool" render "$scene" --resolution 64x24 --quiet --out "$work/one/flat.exr" || fail "flat: exit $?"
+mpi 3 render "$scene" --resolution 64x24 --quiet --out "$work/band/flat.exr" || fail "3 ranks, 2 bands: exit $?"
+same "$work/one/flat.exr" "$work/band/flat.exr"
+mpi 3 render "$scene" "${small[@]}" --frames 1-2 --out "$work/r3/two.exr" || fail "3 ranks, 2 frames: exit $?"
+for f in 1 2; do same "$work/one/f.000$f.exr" "$work/r3/two.000$f.exr"; done
+# An error on the leader alone (its folder gone) ends the job: one line naming the rank, status 2.
+mpi 2 render "$scene" "${small[@]}" --out "$work/gone/x.exr" >/dev/null 2>"$work/err"
+status=$?
+[ "$status" -eq 2 ] || fail "leader's error: mpirun exited $status, expected 2"
+grep -q "^vdbtrace: rank 0 of 2: cannot write .*folder .* is missing (ending the job)$" "$work/err" ||
+    fail "leader's error: $(head -3 "$work/err")"
+
 # Rank 1 killed once rank 0 has written a frame: the job fails, saying which rank died.
 big=(--resolution 320x240 --frames 1-12)
 mpi 2 render "$scene" "${big[@]}" --out "$work/kill/f.exr" >"$work/kill.out" 2>&1 &

@@ -412,6 +412,23 @@ for f in 0002 0003 0004; do
     [ -s "$work/seq/f.$f.exr" ] && [ -s "$work/seq/f.$f.png" ] || fail "render --frames wrote no frame $f"
 done
 [ -e "$work/seq/f.exr" ] && fail "render --frames also wrote the unnumbered name"
+# Resuming: the same job keeps its frames (a deleted one is rendered again); other settings
+# render every frame again.
+rm "$work/seq/f.0003.exr"
+"$vdbtrace" render "$src/scenes/three-firs.json" --frames 2-4 --resolution 32x24 \
+    --out "$work/seq/f.exr" 2>"$work/err" || fail "resume: exit $?"
+grep -q "2 of 3 frames already rendered by this job, kept" "$work/err" || fail "resume: $(grep -v % "$work/err" | head -2)"
+[ "$(grep -c 'seq/f.000[2-4].exr: 32x24' "$work/err")" -eq 1 ] || fail "resume rendered other than frame 3"
+"$vdbtrace" render "$src/scenes/three-firs.json" --frames 2-4 --resolution 32x24 \
+    --method geometry --samples 2 --out "$work/seq/f.exr" 2>"$work/err" || fail "another job: exit $?"
+grep -q "kept" "$work/err" && fail "another job's frames were kept"
+[ "$(grep -c 'seq/f.000[2-4].exr: 32x24' "$work/err")" -eq 3 ] || fail "another job did not render all 3 frames"
+# A frame beyond the path's own whose camera cannot render: refused by number.
+printf '%s' '{"camera": {"position": [0, -10, 100], "look_at": [0, 10, 100]},
+ "camera_path": {"keys": [{"frame": 0}, {"frame": 10, "position": [0, 10, 100], "look_at": [0, -10, 100]}],
+                 "interpolation": "linear", "frames": [0, 3]},
+ "lights": [{"type": "directional", "direction": [0, 0, 1]}], "trees": []}' >"$work/turn.json"
+expect_error "a frame that cannot render" 2 "at frame 5 of .*look_at equals position" -- render "$work/turn.json" --frames 4-6 --resolution 8x6 --out "$work/seq/t.exr"
 "$vdbtrace" render --help >/dev/null || fail "render --help"
 "$vdbtrace" animate-compare --help >/dev/null || fail "animate-compare --help"
 "$vdbtrace" bench --help >/dev/null || fail "bench --help"

@@ -51,10 +51,14 @@ TEST(FrameParts, RowBandsCoverTheWindowInWholeTileRows)
                 EXPECT_EQ(bands[b].x1, w.x1);
                 EXPECT_GT(bands[b].y1, bands[b].y0);
                 EXPECT_EQ((bands[b].y0 - w.y0) % 16, 0) << "band " << b;
-                if (b > 0) EXPECT_EQ(bands[b].y0, bands[b - 1].y1);
+                if (b > 0) {
+                    EXPECT_EQ(bands[b].y0, bands[b - 1].y1);
+                }
             }
             // As many bands as asked wherever the window has that many tile rows.
-            if ((w.y1 - w.y0 + 15) / 16 >= count) EXPECT_EQ(int(bands.size()), count);
+            if ((w.y1 - w.y0 + 15) / 16 >= count) {
+                EXPECT_EQ(int(bands.size()), count);
+            }
         }
     }
 }
@@ -147,7 +151,8 @@ TEST(FrameSequence, RangesAndFileNames)
     EXPECT_EQ(parseFrameRange("3-17").first, 3);
     EXPECT_EQ(parseFrameRange("3-17").last, 17);
     EXPECT_EQ(parseFrameRange("5").count(), 1);
-    for (const char* bad : {"", "-3", "7-2", "3-", "1-4x", "a", "2-b"}) {
+    for (const char* bad : {"", "-3", "7-2", "3-", "1-4x", "a", "2-b", "12abc", " 3-5", "3- 5",
+                            "1-+2", "99999999999999999999", "3-99999999"}) {
         EXPECT_THROW(parseFrameRange(bad), InputError) << bad;
     }
     EXPECT_EQ(frameFile("out/forest.exr", 12).string(), "out/forest.0012.exr");

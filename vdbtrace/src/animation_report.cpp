@@ -138,8 +138,11 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
         md << (k ? ", " : " ") << frameNumbers[std::size_t(stripFrames[k])];
     }
     md << ".\n\nRegenerate: `vdbtrace animate-compare " << o.sceneFile.string()
-       << " --out-dir DIR --resolution " << a.width << "x" << a.height
-       << (o.addSelfShadowing ? " --self-shadowing" : "") << "`.\n";
+       << " --out-dir DIR --frames " << frameNumbers.front() << "-" << frameNumbers.back()
+       << " --resolution " << a.width << "x" << a.height << " --strip " << stripFrames.size()
+       << (o.addSelfShadowing ? " --self-shadowing" : "")
+       << "`, with the same model switches (the scene's own here: " << scene.render.model.boughLaw
+       << " bough law, " << scene.render.model.layerModel << " layer model).\n";
     return md.str();
 }
 
@@ -179,6 +182,12 @@ AnimationFlicker runAnimationCompare(const AnimationCompareOptions& o)
     for (int f = range.first; f <= range.last; ++f) {
         frameNumbers.push_back(f);
         cameras.push_back(scene.cameraPath.at(f, scene.camera));
+        // The file checks its own frames; --frames may name others.
+        const std::string problem = scenes::cameraProblem(cameras.back());
+        if (!problem.empty()) {
+            throw InputError("--frames: at frame " + std::to_string(f) + " of '" +
+                             o.sceneFile.string() + "'s camera_path, " + problem);
+        }
     }
     // Evenly spaced from the first frame to the last.
     std::vector<int> stripFrames;

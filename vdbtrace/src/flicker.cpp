@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace pine::vdbtrace {
@@ -87,6 +88,11 @@ FlickerBreakdown flickerBreakdown(const std::vector<Image>& frames,
     for (std::size_t t = 0; t < count; ++t) {
         out.residualPerFrame[t] = std::sqrt(out.residualPerFrame[t] / pixels);
         out.luminancePerFrame[t] /= pixels;
+    }
+    if (window == 3) {
+        // The first and last frames have one neighbour: no departure to tell.
+        out.residualPerFrame.front() = out.residualPerFrame.back() =
+            std::numeric_limits<double>::quiet_NaN();
     }
     return out;
 }

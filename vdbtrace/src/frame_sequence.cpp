@@ -2,18 +2,28 @@
 
 #include "pine/support/input_error.h"
 
+#include <charconv>
 #include <cstdio>
+#include <system_error>
 
 namespace pine::vdbtrace {
 
 FrameRange parseFrameRange(const std::string& text)
 {
+    // Digits, then optionally '-' and digits: nothing else (no sign, space or tail).
+    const auto number = [](const char*& at, const char* end, int& value) {
+        if (at == end || *at < '0' || *at > '9') return false;
+        const auto [next, error] = std::from_chars(at, end, value);
+        at = next;
+        return error == std::errc();
+    };
     FrameRange r;
-    char tail = 0;
-    const int read = std::sscanf(text.c_str(), "%d-%d%c", &r.first, &r.last, &tail);
-    if (read == 1 && text.find('-') == std::string::npos) r.last = r.first;
-    const bool ok = (read == 2 || (read == 1 && r.last == r.first)) && r.first >= 0 &&
-                    r.last >= r.first && r.last <= 9999999;
+    const char* at = text.data();
+    const char* end = at + text.size();
+    bool ok = number(at, end, r.first);
+    r.last = r.first;
+    if (ok && at != end) ok = *at++ == '-' && number(at, end, r.last);
+    ok = ok && at == end && r.last >= r.first && r.last <= 9999999;
     if (!ok) {
         throw InputError("--frames '" + text + "': expected A-B (0 <= A <= B) or one frame A");
     }

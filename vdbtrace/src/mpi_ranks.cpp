@@ -18,8 +18,9 @@ constexpr int kSizeTag = 1, kPieceTag = 2;
 
 // Open MPI's blocking calls spin while they wait: rank 0 waiting for another rank's frame,
 // or a rank waiting for rank 0 to take its frame, would burn a core the renders need (measured:
-// 2 ranks on 2 cores took 17% more CPU than 1). Each call is started, then tested every
-// millisecond, asleep in between: a frame takes seconds, the millisecond is nothing.
+// the paper forest's 24 frames on 2 ranks, 2 cores: 93.7 CPU-s, 80.1 asleep). Each call is
+// started, then tested every millisecond, asleep in between: a frame takes seconds, the
+// millisecond is nothing.
 void await(MPI_Request& request)
 {
     for (;;) {

@@ -31,6 +31,7 @@
 #include "pine/vdbtrace/traced_scene.h"
 #include "pine/vdbtrace/tree_foliage.h"
 
+#include <sched.h>
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 #include <CLI/CLI.hpp>
@@ -237,37 +238,45 @@ vdbtrace::TracedSceneParts partsWithin(const vdbtrace::RenderMethod& method, dou
 }
 
 /// What names a frame's render, so that a resumed job keeps only frames rendered as it would
-/// render them: the scene file's bytes and every option that changes a pixel.
+/// render them: the renderer's own bytes (a rebuilt vdbtrace may shade otherwise), the scene
+/// file's bytes, the grids' manifests (their checksums) and every option that changes a pixel.
 std::string frameJobDigest(const fs::path& sceneFile, const std::string& methodName,
                            const vdbtrace::MethodSettings& settings,
                            const std::vector<fs::path>& gridFiles, const ModelOverrides& model,
                            const FrameOverrides& frame, const std::vector<std::string>& aovs)
 {
-    std::ifstream in(sceneFile, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    nlohmann::json job = {{"scene", text.str()},
-                          {"method", methodName},
-                          {"voxel_size", settings.voxelSize_cm},
-                          {"subpixels", settings.reference.subpixels},
-                          {"samples", settings.geometry.samples},
-                          {"sample_seed", settings.geometry.sampleSeed},
-                          {"primitive", int(settings.geometry.primitive)},
-                          {"force_level", settings.multiscale.forceLevel},
-                          {"paper", model.paper},
-                          {"bough_law", model.boughLaw},
-                          {"layer_model", model.layerModel},
-                          {"extinction_law", model.extinctionLaw},
-                          {"shadow_origin", model.shadowOrigin},
-                          {"bark", model.bark},
-                          {"layer_correlation", model.layerCorrelation},
-                          {"level_blend", model.levelBlend},
-                          {"cone_level_max", model.coneLevelMax},
-                          {"resolution", {frame.width, frame.height}},
-                          {"crop", {frame.crop.x0, frame.crop.y0, frame.crop.x1, frame.crop.y1}},
-                          {"aovs", aovs}};
-    for (const fs::path& g : gridFiles) job["grids"].push_back(fs::absolute(g).string());
     io::Fnv1a64 hash;
+    const auto addFile = [&hash](const fs::path& file) {
+        std::ifstream in(file, std::ios::binary);
+        std::vector<char> chunk(1 << 16);
+        while (in.read(chunk.data(), std::streamsize(chunk.size())) || in.gcount() > 0) {
+            hash.update(std::string_view(chunk.data(), std::size_t(in.gcount())));
+        }
+        hash.update(file.filename().string());  // a missing file still says so
+    };
+    addFile("/proc/self/exe");
+    addFile(sceneFile);
+    for (const fs::path& g : gridFiles) addFile(g.string() + ".json");
+    const nlohmann::json job = {
+        {"method", methodName},
+        {"voxel_size", settings.voxelSize_cm},
+        {"subpixels", settings.reference.subpixels},
+        {"samples", settings.geometry.samples},
+        {"sample_seed", settings.geometry.sampleSeed},
+        {"primitive", int(settings.geometry.primitive)},
+        {"force_level", settings.multiscale.forceLevel},
+        {"paper", model.paper},
+        {"bough_law", model.boughLaw},
+        {"layer_model", model.layerModel},
+        {"extinction_law", model.extinctionLaw},
+        {"shadow_origin", model.shadowOrigin},
+        {"bark", model.bark},
+        {"layer_correlation", model.layerCorrelation},
+        {"level_blend", model.levelBlend},
+        {"cone_level_max", model.coneLevelMax},
+        {"resolution", {frame.width, frame.height}},
+        {"crop", {frame.crop.x0, frame.crop.y0, frame.crop.x1, frame.crop.y1}},
+        {"aovs", aovs}};
     hash.update(job.dump());
     return io::Fnv1a64::hex(hash.value());
 }
@@ -304,6 +313,8 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     const auto started = Clock::now();
     const bool animation = frameRange.has_value();
     const bool leader = ranks.rank() == 0;
+    // The ranks on one machine share its memory.
+    const double memoryLimit = bake::memoryLimit(maxMemoryGiB) / ranks.sizeOnThisMachine();
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
     vdbtrace::TracedSceneParts parts = partsWithin(method, lawCacheMiB);
     // The extension decides the format: only EXR holds the render (its PNG goes beside it).
@@ -338,11 +349,12 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     io::checkOutputsApart({first, besideWith(first, ".png"),
                            levelPng ? besideWith(first, ".level.png") : fs::path(), firstStats},
                           inputs);
-    vdbtrace::loadImageIo();
+    if (leader) vdbtrace::loadImageIo();  // the others send their images to it
     // Frames of an interrupted job already rendered as this one would are kept: the leader
     // looks, every rank hears which are left.
     const std::string job =
-        frameJobDigest(sceneFile, methodName, settings, gridFiles, model, frame, aovs);
+        animation ? frameJobDigest(sceneFile, methodName, settings, gridFiles, model, frame, aovs)
+                  : std::string();
     std::vector<int> toRender;
     if (animation) {
         if (leader) {
@@ -370,7 +382,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     if (methodName == "reference" && !gridFiles.empty()) {
         std::vector<bake::TreeGrids> trees;
         for (const fs::path& file : gridFiles) {
-            bake::ReadGrids read = bake::readTreeGrids(file, bake::memoryLimit(maxMemoryGiB));
+            bake::ReadGrids read = bake::readTreeGrids(file, memoryLimit);
             if (!read.unverified.empty()) {
                 std::cerr << "vdbtrace: warning: '" << file.string() << "': " << read.unverified
                           << '\n';
@@ -402,7 +414,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                     settings.geometry.primitive == vdbtrace::NeedlePrimitive::Curve,
                     lawProfiles_bytes);
             };
-            const double limit = bake::memoryLimit(maxMemoryGiB);
+            const double limit = memoryLimit;
             bake::ResourceEstimate needs = estimate(lawCacheBytes(lawCacheMiB));
             // Without --law-cache, profiles that would not fit are kept within what is left,
             // as --law-cache would keep them: the same image, some recomputed. (Each estimate
@@ -429,6 +441,16 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             if (scene.cameraPath.empty()) {
                 throw InputError("--frames: '" + sceneFile.string() +
                                  "' has no camera_path (docs/scene-format.md) to move along");
+            }
+            // The file checks its own frames; --frames may name others, where the camera
+            // holds or a smooth path overshoots.
+            for (const int f : toRender) {
+                const std::string problem =
+                    scenes::cameraProblem(scene.cameraPath.at(f, scene.camera));
+                if (!problem.empty()) {
+                    throw InputError("--frames: at frame " + std::to_string(f) + " of '" +
+                                     sceneFile.string() + "'s camera_path, " + problem);
+                }
             }
             scene.camera = scene.cameraPath.at(firstOfMine, scene.camera);
         },
@@ -479,6 +501,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     const auto renderAt = [&](std::optional<int> f, const vdbtrace::PixelWindow& window,
                               bool last) {
         if (f != tracedFor) {
+            loaded->traced = vdbtrace::TracedScene();  // never two at once: --max-memory holds one
             loaded->scene.camera = path.at(*f, still);
             loaded->traced = vdbtrace::buildTracedScene(loaded->scene, parts);
             tracedFor = f;
@@ -668,13 +691,24 @@ int renderOnRanks(vdbtrace::Ranks& ranks, CLI::App& app, const std::function<int
     if (ranks.size() == 1) return body();
     std::unique_ptr<tbb::global_control> share;
     if (app.get_option("--threads")->count() == 0) {
+        // mpirun may bind a rank to fewer cores (Open MPI 4 binds to one core a rank with 2
+        // ranks or fewer): its TBB threads follow the binding, and a rank bound to less than
+        // its share is told so.
         const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
-        share = std::make_unique<tbb::global_control>(
-            tbb::global_control::max_allowed_parallelism,
-            std::size_t(std::max(1, cores / ranks.sizeOnThisMachine())));
+        const int shareOfCores = std::max(1, cores / ranks.sizeOnThisMachine());
+        cpu_set_t mask;
+        CPU_ZERO(&mask);
+        const int bound = sched_getaffinity(0, sizeof mask, &mask) == 0 ? CPU_COUNT(&mask) : cores;
+        if (bound < shareOfCores && ranks.rank() == 0) {
+            std::cerr << "vdbtrace: warning: mpirun bound each rank to " << bound << " of the "
+                      << shareOfCores << " cores it could use (mpirun --bind-to none lets it)\n";
+        }
+        share = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                      std::size_t(std::min(bound, shareOfCores)));
     }
     if (ranks.rank() != 0) tool::setQuiet(true);
-    const auto fail = [&](const std::string& what, int status) {
+    const auto fail = [&](std::string what, int status) {
+        std::replace(what.begin(), what.end(), '\n', ' ');
         tool::Progress::endOpenLine();
         std::cerr << "vdbtrace: rank " << ranks.rank() << " of " << ranks.size() << ": " << what
                   << " (ending the job)\n";

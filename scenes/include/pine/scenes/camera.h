@@ -4,6 +4,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <string>
 #include <vector>
 
 namespace pine::scenes {
@@ -46,6 +47,10 @@ struct CameraPath {
     /// The camera at `frame`, its resolution `still`'s. Requires !empty().
     Camera at(double frame, const Camera& still) const;
 };
+
+/// Why `camera` cannot render (its look-at on its position, its up along the view or zero, its
+/// field of view outside (0, 180) degrees), or empty if it can.
+std::string cameraProblem(const Camera& camera);
 
 /// The interpolation's names as a scene file writes them ("smooth", "linear").
 const char* interpolationName(CameraPath::Interpolation interpolation);

@@ -27,7 +27,7 @@ double temporalFlicker(const std::vector<Image>& frames);
 /// the line through its two neighbours, l(t) - (l(t-1) + l(t+1)) / 2, whose variance for
 /// frames that jitter independently by sigma is 1.5 sigma^2, so the pixel's flicker is
 /// sqrt(mean of its squares / 1.5): sigma itself, 0 for any motion linear over three frames.
-/// The first and last frames then have no departure (0 in residualPerFrame).
+/// The first and last frames then have no departure (NaN in residualPerFrame).
 struct FlickerBreakdown {
     double flicker = 0.0;         ///< the mean over all pixels
     std::vector<double> perBand;  ///< the mean over the band's pixels (0 where none)
