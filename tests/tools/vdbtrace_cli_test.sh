@@ -398,13 +398,20 @@ expect_error "temporal report without a path" 2 "has no camera_path" -- animate-
 expect_error "temporal report of 2 frames" 2 "at least 3 frames" -- animate-compare "$src/scenes/three-firs.json" --frames 1-2 --self-shadowing --out-dir "$work/anim"
 expect_error "temporal report, effects unmatched" 2 "self_shadowing" -- animate-compare "$src/scenes/paper-forest.json" --out-dir "$work/anim"
 "$vdbtrace" animate-compare "$src/scenes/three-firs.json" --frames 2-5 --resolution 32x24 \
-    --self-shadowing --strip 2 --no-plot --out-dir "$work/anim" --quiet || fail "animate-compare: exit $?"
+    --self-shadowing --strip 2 --no-plot --truth-samples 4 --out-dir "$work/anim" --quiet ||
+    fail "animate-compare: exit $?"
 for f in report.md flicker.csv frames.csv strip.png; do
     [ -s "$work/anim/$f" ] || fail "animate-compare wrote no $f"
 done
-# 3 methods x (all pixels + 4 bands), and 4 frames each.
-[ "$(tail -n +2 "$work/anim/flicker.csv" | wc -l)" -eq 15 ] || fail "flicker.csv: $(cat "$work/anim/flicker.csv")"
-[ "$(grep -c '^[2-5],' "$work/anim/frames.csv")" -eq 12 ] || fail "frames.csv: $(cat "$work/anim/frames.csv")"
+# 3 methods and the truth x (all pixels + 4 bands), and 4 frames each; the truth's row alone
+# has no error flicker.
+[ "$(tail -n +2 "$work/anim/flicker.csv" | wc -l)" -eq 20 ] || fail "flicker.csv: $(cat "$work/anim/flicker.csv")"
+[ "$(grep -c '^[2-5],' "$work/anim/frames.csv")" -eq 16 ] || fail "frames.csv: $(cat "$work/anim/frames.csv")"
+[ "$(grep -c '^truth_geometry_4spp,[a-z]*,[0-9]*,[0-9.e-]*,,' "$work/anim/flicker.csv")" -eq 5 ] ||
+    fail "flicker.csv: the truth's rows: $(grep truth "$work/anim/flicker.csv")"
+[ "$(grep -c '^geometry_1spp,[a-z]*,[0-9]*,[0-9.e-]*,[0-9]' "$work/anim/flicker.csv")" -eq 5 ] ||
+    fail "flicker.csv: no error flicker for geometry_1spp"
+grep -q "## Against the truth" "$work/anim/report.md" || fail "report.md has no truth section"
 mkdir -p "$work/seq"
 "$vdbtrace" render "$src/scenes/three-firs.json" --frames 2-4 --resolution 32x24 --quiet \
     --out "$work/seq/f.exr" || fail "render --frames: exit $?"

@@ -123,9 +123,9 @@ TEST(LevelBands, EachPixelTakesItsMeanLevelWhereItHasFoliage)
     EXPECT_THROW(levelBands(frames), ImageError);
 }
 
-// The methods along three-firs' path: each sequence's flicker is what the frames rendered one by
-// one give under an independent computation (second differences summed here), and the frames
-// kept are those renders.
+// The methods along three-firs' path, with a truth: each sequence's flicker, and each method's
+// error flicker against the truth, are what the frames rendered one by one give under an
+// independent computation (second differences summed here); the frames kept are those renders.
 TEST(AnimationFlicker, EachSequenceIsItsFramesRenderedAlone)
 {
     scenes::Scene scene =
@@ -134,18 +134,36 @@ TEST(AnimationFlicker, EachSequenceIsItsFramesRenderedAlone)
     scene.camera.height = 30;
     std::vector<scenes::Camera> cameras;
     for (int f = 1; f <= 5; ++f) cameras.push_back(scene.cameraPath.at(f, scene.camera));
-    const AnimationFlicker a = measureAnimationFlicker(scene, cameras, {0, 3}, 3, {});
-    ASSERT_EQ(a.rows.size(), std::size(kAnimationSequences));
+    const AnimationFlicker a = measureAnimationFlicker(scene, cameras, {0, 3}, 3, 4, {});
+    ASSERT_EQ(a.rows.size(), std::size(kAnimationSequences) + 1);
+    ASSERT_TRUE(a.rows.back().truth);
+    EXPECT_FALSE(a.rows.back().errorFlicker);
+    // Mean over pixels of sqrt(mean over inner frames of the second difference^2 / 1.5).
+    const auto localFlicker = [](const std::vector<std::vector<double>>& lum) {
+        double sum = 0.0;
+        for (std::size_t i = 0; i < lum[0].size(); ++i) {
+            double squares = 0.0;
+            for (std::size_t t = 1; t + 1 < lum.size(); ++t) {
+                const double d = lum[t][i] - 0.5 * (lum[t - 1][i] + lum[t + 1][i]);
+                squares += d * d;
+            }
+            sum += std::sqrt(squares / double(lum.size() - 2) / 1.5);
+        }
+        return sum / double(lum[0].size());
+    };
+    std::vector<std::vector<std::vector<double>>> lums;  // [sequence][frame][pixel]
     for (std::size_t m = 0; m < a.rows.size(); ++m) {
-        const AnimationSequence& q = kAnimationSequences[m];
-        std::vector<std::vector<double>> lum;  // [frame][pixel]
+        const bool truth = m == std::size(kAnimationSequences);
+        const char* method = truth ? "geometry" : kAnimationSequences[m].method;
+        std::vector<std::vector<double>> lum;
         for (std::size_t f = 0; f < cameras.size(); ++f) {
             scenes::Scene at = scene;
             at.camera = cameras[f];
             const TracedScene traced = buildTracedScene(at);
             MethodSettings settings;
-            settings.geometry.samples = std::max(1, q.samples);
-            const RenderResult r = renderMethod(q.method).render(traced, settings, {});
+            settings.geometry.samples = truth ? 4 : std::max(1, kAnimationSequences[m].samples);
+            settings.geometry.sampleSeed = truth ? 1 : 0;
+            const RenderResult r = renderMethod(method).render(traced, settings, {});
             std::vector<double> l;
             for (std::size_t i = 0; i + 3 < r.image.rgba.size(); i += 4) {
                 l.push_back(0.2126 * r.image.rgba[i] + 0.7152 * r.image.rgba[i + 1] +
@@ -154,21 +172,22 @@ TEST(AnimationFlicker, EachSequenceIsItsFramesRenderedAlone)
             lum.push_back(l);
             if (f == 0 || f == 3) {
                 const Image& kept = a.rows[m].kept[f == 0 ? 0 : 1];
-                EXPECT_EQ(kept.rgba, r.image.rgba) << q.label << ", frame " << f;
+                EXPECT_EQ(kept.rgba, r.image.rgba) << a.rows[m].method << ", frame " << f;
             }
         }
-        double sum = 0.0;
-        for (std::size_t i = 0; i < lum[0].size(); ++i) {
-            double squares = 0.0;
-            for (std::size_t t = 1; t + 1 < lum.size(); ++t) {
-                const double d = lum[t][i] - 0.5 * (lum[t - 1][i] + lum[t + 1][i]);
-                squares += d * d;
-            }
-            sum += std::sqrt(squares / 3.0 / 1.5);
+        EXPECT_NEAR(a.rows[m].flicker.flicker, localFlicker(lum), 1e-9) << a.rows[m].method;
+        EXPECT_GT(a.rows[m].flicker.flicker, 0.0) << a.rows[m].method;
+        EXPECT_GT(a.rows[m].cpuSecondsPerFrame, 0.0) << a.rows[m].method;
+        lums.push_back(std::move(lum));
+    }
+    for (std::size_t m = 0; m < std::size(kAnimationSequences); ++m) {
+        std::vector<std::vector<double>> error = lums[m];
+        for (std::size_t f = 0; f < error.size(); ++f) {
+            for (std::size_t i = 0; i < error[f].size(); ++i) error[f][i] -= lums.back()[f][i];
         }
-        EXPECT_NEAR(a.rows[m].flicker.flicker, sum / double(lum[0].size()), 1e-9) << q.label;
-        EXPECT_GT(a.rows[m].flicker.flicker, 0.0) << q.label;
-        EXPECT_GT(a.rows[m].cpuSecondsPerFrame, 0.0) << q.label;
+        ASSERT_TRUE(a.rows[m].errorFlicker) << a.rows[m].method;
+        // Float frames subtracted before the luminance here, after it there: equal to rounding.
+        EXPECT_NEAR(a.rows[m].errorFlicker->flicker, localFlicker(error), 1e-6) << a.rows[m].method;
     }
 }
 

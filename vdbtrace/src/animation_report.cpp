@@ -20,15 +20,24 @@ constexpr int kPathWindow = 3;
 std::string flickerCsv(const AnimationFlicker& a)
 {
     std::ostringstream csv;
-    csv << "method,band,pixels,flicker,seconds_per_frame,cpu_seconds_per_frame\n"
+    csv << "method,band,pixels,flicker,error_flicker,seconds_per_frame,cpu_seconds_per_frame\n"
         << std::setprecision(6);
     for (const AnimationRow& r : a.rows) {
+        // The error's flicker is empty without a truth (and on the truth's own row).
+        const auto error = [&r](std::size_t band) {
+            std::ostringstream v;
+            v << std::setprecision(6);
+            if (r.errorFlicker) {
+                v << (band == 0 ? r.errorFlicker->flicker : r.errorFlicker->perBand[band - 1]);
+            }
+            return v.str();
+        };
         csv << r.method << ",all," << std::size_t(a.width) * a.height << ',' << r.flicker.flicker
-            << ',' << r.secondsPerFrame << ',' << r.cpuSecondsPerFrame << '\n';
+            << ',' << error(0) << ',' << r.secondsPerFrame << ',' << r.cpuSecondsPerFrame << '\n';
         for (std::size_t b = 0; b < r.flicker.perBand.size(); ++b) {
             csv << r.method << ',' << kLevelBandKeys[b] << ',' << r.flicker.bandPixels[b] << ','
-                << r.flicker.perBand[b] << ',' << r.secondsPerFrame << ',' << r.cpuSecondsPerFrame
-                << '\n';
+                << r.flicker.perBand[b] << ',' << error(b + 1) << ',' << r.secondsPerFrame << ','
+                << r.cpuSecondsPerFrame << '\n';
         }
     }
     return csv.str();
@@ -116,9 +125,47 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
     md << " | |\n\n";
     const AnimationRow& ms = a.rows.front();
     for (std::size_t m = 1; m < a.rows.size(); ++m) {
+        if (a.rows[m].truth) continue;
         md << "- " << a.rows[m].method << " flickers "
            << number(a.rows[m].flicker.flicker / std::max(ms.flicker.flicker, 1e-30))
            << " times as much as " << ms.method << ".\n";
+    }
+    if (a.rows.back().truth) {
+        const AnimationRow& truth = a.rows.back();
+        md << "\n## Against the truth\n\n"
+           << truth.method << " (geometry on its own sample seed) is the truth. Its own "
+           << "flicker, " << number(truth.flicker.flicker) << " ("
+           << number(truth.flicker.perBand[3])
+           << " on the bough-level pixels), is the motion's: edges sweeping across pixels, "
+           << "which every method shares. The **error flicker** is the flicker of each method's "
+           << "frames less the truth's: the motion is in both and cancels, a bias that changes "
+           << "smoothly along the path counts for nothing, and what remains is how the method's "
+           << "error jumps from frame to frame, its temporal aliasing (plus the truth's own "
+           << "noise, the same for every method).\n\n"
+           << "| method | error flicker, all pixels |";
+        for (const char* band : kLevelBandNames) md << ' ' << band << " |";
+        md << "\n|---|---|";
+        for (std::size_t b = 0; b < std::size(kLevelBandNames); ++b) md << "---|";
+        md << "\n";
+        for (const AnimationRow& r : a.rows) {
+            if (!r.errorFlicker) continue;
+            md << "| " << r.method << " | " << number(r.errorFlicker->flicker) << " |";
+            for (std::size_t b = 0; b < r.errorFlicker->perBand.size(); ++b) {
+                md << ' '
+                   << (r.errorFlicker->bandPixels[b] > 0 ? number(r.errorFlicker->perBand[b])
+                                                         : std::string("-"))
+                   << " |";
+            }
+            md << "\n";
+        }
+        md << "\n";
+        for (std::size_t m = 1; m < a.rows.size(); ++m) {
+            if (!a.rows[m].errorFlicker) continue;
+            md << "- " << a.rows[m].method << "'s error flickers "
+               << number(a.rows[m].errorFlicker->flicker /
+                         std::max(ms.errorFlicker->flicker, 1e-30))
+               << " times as much as " << ms.method << "'s.\n";
+        }
     }
     md << "\n## Over the frames\n\n"
        << "Each frame's departure from the pixels' lines (root mean square over the pixels, "
@@ -140,6 +187,7 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
     md << ".\n\nRegenerate: `vdbtrace animate-compare " << o.sceneFile.string()
        << " --out-dir DIR --frames " << frameNumbers.front() << "-" << frameNumbers.back()
        << " --resolution " << a.width << "x" << a.height << " --strip " << stripFrames.size()
+       << (o.truthSamples > 0 ? " --truth-samples " + std::to_string(o.truthSamples) : "")
        << (o.addSelfShadowing ? " --self-shadowing" : "")
        << "`, with the same model switches (the scene's own here: " << scene.render.model.boughLaw
        << " bough law, " << scene.render.model.layerModel << " layer model).\n";
@@ -195,21 +243,21 @@ AnimationFlicker runAnimationCompare(const AnimationCompareOptions& o)
     for (int k = 0; k < shown; ++k) {
         stripFrames.push_back(shown == 1 ? 0 : k * (range.count() - 1) / (shown - 1));
     }
+    const std::size_t sequences = std::size(kAnimationSequences) + (o.truthSamples > 0 ? 1 : 0);
     if (o.maxMemoryBytes > 0.0) {
         // The heavier method's render, plus every frame of every sequence held for the flicker.
         bake::ResourceEstimate needs = bake::estimateRender(scene, "geometry", 1.0);
         const double frameBytes = double(scene.camera.width) * scene.camera.height * 16.0;
-        needs.parts.push_back(
-            {std::to_string(range.count()) + " frames x " +
-                 std::to_string(std::size(kAnimationSequences)) + " methods held",
-             frameBytes * range.count() * (double(std::size(kAnimationSequences)) + 0.25)});
+        needs.parts.push_back({std::to_string(range.count()) + " frames x " +
+                                   std::to_string(sequences) + " methods held",
+                               frameBytes * range.count() * (double(sequences) + 0.25)});
         bake::checkMemory(needs, o.maxMemoryBytes, o.sceneFile.string());
     }
     log(o.sceneFile.string() + ": " + std::to_string(range.count()) + " frames at " +
         std::to_string(scene.camera.width) + " x " + std::to_string(scene.camera.height) + ", " +
-        std::to_string(std::size(kAnimationSequences)) + " methods");
+        std::to_string(sequences) + " methods");
     const AnimationFlicker a =
-        measureAnimationFlicker(scene, cameras, stripFrames, kPathWindow, log);
+        measureAnimationFlicker(scene, cameras, stripFrames, kPathWindow, o.truthSamples, log);
 
     io::writeTextAtomically(o.outDir / "flicker.csv", flickerCsv(a));
     io::writeTextAtomically(o.outDir / "frames.csv", framesCsv(a, frameNumbers));

@@ -23,7 +23,7 @@ DollyFlicker measureDollyFlicker(const scenes::Scene& base, const CompareSetting
         cameras.push_back(c);
     }
     const AnimationFlicker measured =
-        measureAnimationFlicker(base, cameras, {}, 0, [&log](const std::string& line) {
+        measureAnimationFlicker(base, cameras, {}, 0, 0, [&log](const std::string& line) {
             if (log) log("dolly " + line);
         });
     for (const AnimationRow& row : measured.rows) {

@@ -44,8 +44,10 @@ std::unique_ptr<Ranks> jobRanks(int& argc, char**& argv)
     const auto entry = reinterpret_cast<Entry>(
         loadModuleEntry(kRanksModuleFile, kRanksModuleEntry, "the MPI module", error));
     if (!entry) {
-        throw InputError("started by mpirun, but " + error +
-                         " (configure with MPI installed: scripts/install-deps.sh adds it)");
+        throw InputError(
+            "started by mpirun, but " + error +
+            " (this build has no MPI: install it with scripts/install-deps.sh and configure with "
+            "PINE_WITH_MPI on, the default)");
     }
     return std::unique_ptr<Ranks>(entry(&argc, &argv));
 }

@@ -1418,6 +1418,13 @@ int main(int argc, char** argv)
                          "explicit needles always self-shadow; a scene with shadows alone is "
                          "refused without it)");
     animateCmd->add_flag("--no-plot", animateNoPlot, "Skip flicker_frames.png");
+    animateCmd
+        ->add_option("--truth-samples", animate.truthSamples,
+                     "Also render geometry at N samples a pixel (its own seed) as the truth, and "
+                     "each method's error flicker against it: the camera's motion cancels (0: "
+                     "none)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 65536));
     addMaxMemory(*animateCmd, maxMemoryGiB, "a temporal comparison");
     model.add(*animateCmd);
 

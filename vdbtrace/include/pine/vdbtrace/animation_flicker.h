@@ -7,6 +7,7 @@
 #include "pine/vdbtrace/compare_run.h"
 #include "pine/vdbtrace/flicker.h"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,13 +30,18 @@ struct AnimationRow {
     /// Over every pixel, by level band (levelBands of the multiscale frames, the same pixels
     /// for every method), and frame by frame.
     FlickerBreakdown flicker;
+    /// With a truth: the flicker of this method's error, its frames less the truth's. The
+    /// camera's motion is in both and cancels; what remains is how the method's error jumps
+    /// from frame to frame (its aliasing), plus the truth's own noise.
+    std::optional<FlickerBreakdown> errorFlicker;
+    bool truth = false;               ///< the truth's own row (its flicker: the motion's)
     double secondsPerFrame = 0.0;     ///< the render's wall seconds (RenderResult::seconds)
     double cpuSecondsPerFrame = 0.0;  ///< the process's CPU seconds during the render
     std::vector<Image> kept;          ///< the frames asked to be kept, RGBA alone
 };
 
 struct AnimationFlicker {
-    std::vector<AnimationRow> rows;  ///< one per kAnimationSequences, in order
+    std::vector<AnimationRow> rows;  ///< one per kAnimationSequences, in order, then the truth
     int width = 0, height = 0;
 };
 
@@ -44,10 +50,11 @@ struct AnimationFlicker {
 /// `keep` are kept in each row. `log` hears each frame. Throws ImageError with fewer than 3
 /// cameras, and what preparing and rendering throw.
 /// `window`: flickerBreakdown's (0: one line per pixel over the whole sequence; 3: the line
-/// through each frame's neighbours).
+/// through each frame's neighbours). `truthSamples` > 0 adds a last row, geometry at that many
+/// samples a pixel on its own sample seed, against which each method's error flickers.
 AnimationFlicker measureAnimationFlicker(const scenes::Scene& scene,
                                          const std::vector<scenes::Camera>& cameras,
-                                         const std::vector<int>& keep, int window,
+                                         const std::vector<int>& keep, int window, int truthSamples,
                                          const CompareLog& log);
 
 }  // namespace pine::vdbtrace

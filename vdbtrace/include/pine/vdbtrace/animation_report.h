@@ -16,6 +16,9 @@ struct AnimationCompareOptions {
     std::optional<FrameRange> frames;  ///< none: the path's own [first, last]
     int width = 0, height = 0;         ///< override of the camera's resolution (0: the scene's)
     int stripFrames = 4;               ///< frames shown in strip.png, first to last
+    /// > 0: a truth, geometry at this many samples a pixel on its own seed, and each method's
+    /// error flicker against it (animation_flicker.h); 0: none.
+    int truthSamples = 0;
     /// Adds "self_shadowing" where the scene's effects name "shadows" (as compare: the
     /// explicit needles always self-shadow, checkEffects).
     bool addSelfShadowing = false;
