@@ -4,7 +4,7 @@
 #include "pine/support/input_error.h"
 
 #include <cstdlib>
-#include <exception>
+#include <stdexcept>
 
 namespace pine::vdbtrace {
 namespace {
