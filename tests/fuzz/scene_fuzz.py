@@ -130,6 +130,20 @@ def generated():
     s = copy.deepcopy(base_scenes["bough.json"])
     s["camera"]["up"] = [0, 30, -10]  # along the view direction
     bombs.append(("up-along-view", s))
+    # Camera paths: too many frames, the most frames allowed (each checked as the file is
+    # read), and a smooth curve overshooting its keys' field of view below 0.
+    s = copy.deepcopy(base_scenes["bough.json"])
+    s["camera_path"] = {"keys": [{"frame": 0}, {"frame": 9999999, "fov_deg": 20}],
+                        "frames": [0, 9999999]}
+    bombs.append(("path-frames-bomb", s))
+    s = copy.deepcopy(base_scenes["bough.json"])
+    s["camera_path"] = {"keys": [{"frame": 0}, {"frame": 99999, "position": [0, -60, 0]}],
+                        "frames": [0, 99999]}
+    bombs.append(("path-100000-frames", s))
+    s = copy.deepcopy(base_scenes["bough.json"])
+    s["camera_path"] = {"keys": [{"frame": 0, "fov_deg": 170}, {"frame": 1, "fov_deg": 170},
+                                 {"frame": 2, "fov_deg": 1}, {"frame": 30, "fov_deg": 1}]}
+    bombs.append(("path-overshoot", s))
     out += [(name, json.dumps(s)) for name, s in bombs]
 
     mutations = []
