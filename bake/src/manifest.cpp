@@ -22,13 +22,7 @@ FileDigest digestFile(const fs::path& file)
     if (!in) throw BakeError("cannot read '" + file.string() + "'");
     Fnv1a64 hash;
     FileDigest digest;
-    std::string chunk(1 << 20, '\0');
-    while (in) {
-        in.read(chunk.data(), std::streamsize(chunk.size()));
-        const auto got = std::size_t(in.gcount());
-        hash.update(std::string_view(chunk.data(), got));
-        digest.bytes += got;
-    }
+    digest.bytes = hash.update(in);
     if (in.bad()) throw BakeError("cannot read '" + file.string() + "'");
     digest.fnv1a64 = hash.value();
     return digest;

@@ -13,6 +13,12 @@
 namespace pine::vdbtrace {
 namespace {
 
+// The report's numbers: three significant digits.
+std::string shown(double v)
+{
+    return formatNumber(v, 3);
+}
+
 // A path's pixels change along curves (a trunk sweeping across them): each frame is measured
 // against its neighbours' line (flicker.h).
 constexpr int kPathWindow = 3;
@@ -76,13 +82,6 @@ Image strip(const AnimationFlicker& a)
     return out;
 }
 
-std::string number(double v, int digits = 3)
-{
-    std::ostringstream s;
-    s << std::setprecision(digits) << v;
-    return s.str();
-}
-
 std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o,
                      const scenes::Scene& scene, const std::vector<int>& frameNumbers,
                      const std::vector<int>& stripFrames, bool plotted)
@@ -90,7 +89,7 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
     std::ostringstream md;
     md << "# Temporal report: " << o.sceneFile.filename().string() << "\n\n"
        << "The scene's camera path, frames " << frameNumbers.front() << "-" << frameNumbers.back()
-       << " (" << frameNumbers.size() << " frames, " << number(scene.cameraPath.framesPerSecond)
+       << " (" << frameNumbers.size() << " frames, " << shown(scene.cameraPath.framesPerSecond)
        << " per second), " << a.width << " x " << a.height
        << ", rendered by each method with the same effects ("
        << (scene.effects.shadows ? "shadows and self-shadowing" : "no shadows")
@@ -112,13 +111,13 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
     for (std::size_t b = 0; b < std::size(kLevelBandNames); ++b) md << "---|";
     md << "---|---|\n";
     for (const AnimationRow& r : a.rows) {
-        md << "| " << r.method << " | " << number(r.flicker.flicker) << " |";
+        md << "| " << r.method << " | " << shown(r.flicker.flicker) << " |";
         for (std::size_t b = 0; b < r.flicker.perBand.size(); ++b) {
             md << ' '
-               << (r.flicker.bandPixels[b] > 0 ? number(r.flicker.perBand[b]) : std::string("-"))
+               << (r.flicker.bandPixels[b] > 0 ? shown(r.flicker.perBand[b]) : std::string("-"))
                << " |";
         }
-        md << ' ' << number(r.secondsPerFrame) << " | " << number(r.cpuSecondsPerFrame) << " |\n";
+        md << ' ' << shown(r.secondsPerFrame) << " | " << shown(r.cpuSecondsPerFrame) << " |\n";
     }
     md << "| pixels in the band | " << std::size_t(a.width) * a.height << " |";
     for (const std::size_t n : a.rows.front().flicker.bandPixels) md << ' ' << n << " |";
@@ -127,15 +126,14 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
     for (std::size_t m = 1; m < a.rows.size(); ++m) {
         if (a.rows[m].truth) continue;
         md << "- " << a.rows[m].method << " flickers "
-           << number(a.rows[m].flicker.flicker / std::max(ms.flicker.flicker, 1e-30))
+           << shown(a.rows[m].flicker.flicker / std::max(ms.flicker.flicker, 1e-30))
            << " times as much as " << ms.method << ".\n";
     }
     if (a.rows.back().truth) {
         const AnimationRow& truth = a.rows.back();
         md << "\n## Against the truth\n\n"
            << truth.method << " (geometry on its own sample seed) is the truth. Its own "
-           << "flicker, " << number(truth.flicker.flicker) << " ("
-           << number(truth.flicker.perBand[3])
+           << "flicker, " << shown(truth.flicker.flicker) << " (" << shown(truth.flicker.perBand[3])
            << " on the bough-level pixels), is the motion's: edges sweeping across pixels, "
            << "which every method shares. The **error flicker** is the flicker of each method's "
            << "frames less the truth's: the motion is in both and cancels, a bias that changes "
@@ -149,10 +147,10 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
         md << "\n";
         for (const AnimationRow& r : a.rows) {
             if (!r.errorFlicker) continue;
-            md << "| " << r.method << " | " << number(r.errorFlicker->flicker) << " |";
+            md << "| " << r.method << " | " << shown(r.errorFlicker->flicker) << " |";
             for (std::size_t b = 0; b < r.errorFlicker->perBand.size(); ++b) {
                 md << ' '
-                   << (r.errorFlicker->bandPixels[b] > 0 ? number(r.errorFlicker->perBand[b])
+                   << (r.errorFlicker->bandPixels[b] > 0 ? shown(r.errorFlicker->perBand[b])
                                                          : std::string("-"))
                    << " |";
             }
@@ -162,8 +160,7 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
         for (std::size_t m = 1; m < a.rows.size(); ++m) {
             if (!a.rows[m].errorFlicker) continue;
             md << "- " << a.rows[m].method << "'s error flickers "
-               << number(a.rows[m].errorFlicker->flicker /
-                         std::max(ms.errorFlicker->flicker, 1e-30))
+               << shown(a.rows[m].errorFlicker->flicker / std::max(ms.errorFlicker->flicker, 1e-30))
                << " times as much as " << ms.method << "'s.\n";
         }
     }
@@ -239,9 +236,9 @@ AnimationFlicker runAnimationCompare(const AnimationCompareOptions& o)
     }
     // Evenly spaced from the first frame to the last.
     std::vector<int> stripFrames;
-    const int shown = std::clamp(o.stripFrames, 1, range.count());
-    for (int k = 0; k < shown; ++k) {
-        stripFrames.push_back(shown == 1 ? 0 : k * (range.count() - 1) / (shown - 1));
+    const int stripCount = std::clamp(o.stripFrames, 1, range.count());
+    for (int k = 0; k < stripCount; ++k) {
+        stripFrames.push_back(stripCount == 1 ? 0 : k * (range.count() - 1) / (stripCount - 1));
     }
     const std::size_t sequences = std::size(kAnimationSequences) + (o.truthSamples > 0 ? 1 : 0);
     if (o.maxMemoryBytes > 0.0) {
@@ -271,10 +268,9 @@ AnimationFlicker runAnimationCompare(const AnimationCompareOptions& o)
                             reportMd(a, o, scene, frameNumbers, stripFrames, plotted));
     std::string summary = std::to_string(range.count()) + " frames x " +
                           std::to_string(a.rows.size()) + " methods in " +
-                          number(std::chrono::duration<double>(Clock::now() - start).count()) +
+                          shown(std::chrono::duration<double>(Clock::now() - start).count()) +
                           " s; flicker";
-    for (const AnimationRow& r : a.rows)
-        summary += " " + r.method + " " + number(r.flicker.flicker);
+    for (const AnimationRow& r : a.rows) summary += " " + r.method + " " + shown(r.flicker.flicker);
     log(summary);
     return a;
 }

@@ -27,14 +27,15 @@ const char* environment(const char* name)
     return value && *value ? value : nullptr;
 }
 
-}  // namespace
-
+// True where the environment says a launcher started this process as one of several.
 bool startedByLauncher()
 {
     // Open MPI's mpirun, then the PMIx and PMI launchers (Slurm's srun, MPICH's hydra).
     return environment("OMPI_COMM_WORLD_SIZE") || environment("PMIX_RANK") ||
            environment("PMI_SIZE");
 }
+
+}  // namespace
 
 std::unique_ptr<Ranks> jobRanks(int& argc, char**& argv)
 {

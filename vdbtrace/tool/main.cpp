@@ -248,10 +248,7 @@ std::string frameJobDigest(const fs::path& sceneFile, const std::string& methodN
     io::Fnv1a64 hash;
     const auto addFile = [&hash](const fs::path& file) {
         std::ifstream in(file, std::ios::binary);
-        std::vector<char> chunk(1 << 16);
-        while (in.read(chunk.data(), std::streamsize(chunk.size())) || in.gcount() > 0) {
-            hash.update(std::string_view(chunk.data(), std::size_t(in.gcount())));
-        }
+        hash.update(in);
         hash.update(file.filename().string());  // a missing file still says so
     };
     addFile("/proc/self/exe");

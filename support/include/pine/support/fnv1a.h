@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <istream>
 #include <string>
 #include <string_view>
 
@@ -17,6 +18,20 @@ public:
             mHash ^= std::uint64_t(static_cast<unsigned char>(c));
             mHash *= 1099511628211ull;
         }
+    }
+    /// Adds what `in` holds, read in chunks up to its end; returns the bytes read (check
+    /// in.bad() after: a read error ends the stream too).
+    std::uintmax_t update(std::istream& in)
+    {
+        std::string chunk(1 << 20, '\0');
+        std::uintmax_t bytes = 0;
+        while (in) {
+            in.read(chunk.data(), std::streamsize(chunk.size()));
+            const auto got = std::size_t(in.gcount());
+            update(std::string_view(chunk.data(), got));
+            bytes += got;
+        }
+        return bytes;
     }
     std::uint64_t value() const { return mHash; }
     /// 16 lower-case hex digits.

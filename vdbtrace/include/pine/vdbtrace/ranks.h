@@ -39,9 +39,6 @@ public:
 /// render everything) or it cannot be loaded.
 std::unique_ptr<Ranks> jobRanks(int& argc, char**& argv);
 
-/// True where the environment says a launcher started this process as one of several.
-bool startedByLauncher();
-
 /// The module's file name and entry point: extern "C" Ranks* pine_mpi_ranks(int*, char***),
 /// returning a new object (MPI_Finalize in its destructor).
 inline constexpr const char* kRanksModuleFile = "libpine_mpi_ranks.so";
