@@ -202,18 +202,12 @@ AnimationFlicker runAnimationCompare(const AnimationCompareOptions& o)
     };
     io::checkWritableFolder(o.outDir);
     loadImageIo();
-    scenes::Scene scene = scenes::loadScene(o.sceneFile);
-    if (o.model) o.model(scene.render.model);
-    if (o.addSelfShadowing) scene.effects.selfShadowing |= scene.effects.shadows;
-    checkEffects(scene.effects);
+    scenes::Scene scene =
+        loadComparedScene(o.sceneFile, o.model, o.addSelfShadowing, o.width, o.height);
     if (scene.cameraPath.empty()) {
         throw InputError("'" + o.sceneFile.string() +
                          "' has no camera_path to compare the methods along "
                          "(docs/scene-format.md)");
-    }
-    if (o.width > 0 && o.height > 0) {
-        scene.camera.width = o.width;
-        scene.camera.height = o.height;
     }
     const FrameRange range =
         o.frames ? *o.frames : FrameRange{scene.cameraPath.firstFrame, scene.cameraPath.lastFrame};

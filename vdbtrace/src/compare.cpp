@@ -35,15 +35,8 @@ CompareRun runCompare(const CompareOptions& options)
     const std::filesystem::path& dir = options.outDir;
     io::checkWritableFolder(dir);
     loadImageIo();
-    scenes::Scene scene = scenes::loadScene(options.sceneFile);
-    if (options.model) options.model(scene.render.model);
-    if (options.addSelfShadowing) scene.effects.selfShadowing |= scene.effects.shadows;
-    checkEffects(scene.effects);
-    if (options.width > 0 && options.height > 0) {
-        // fov_deg is vertical: the view is kept, and kept exactly when the aspect is.
-        scene.camera.width = options.width;
-        scene.camera.height = options.height;
-    }
+    scenes::Scene scene = loadComparedScene(
+        options.sceneFile, options.model, options.addSelfShadowing, options.width, options.height);
     const CompareSettings& st = options.settings;
     if (options.maxMemoryBytes > 0.0) {
         // The truth's check and a budget row's image are held while they are measured.

@@ -95,6 +95,21 @@ void checkEffects(const scenes::Effects& effects)
                      " so that every method computes the same effects");
 }
 
+scenes::Scene loadComparedScene(const std::filesystem::path& file,
+                                const std::function<void(scenes::ModelChoices&)>& model,
+                                bool addSelfShadowing, int width, int height)
+{
+    scenes::Scene scene = scenes::loadScene(file);
+    if (model) model(scene.render.model);
+    if (addSelfShadowing) scene.effects.selfShadowing |= scene.effects.shadows;
+    checkEffects(scene.effects);
+    if (width > 0 && height > 0) {
+        scene.camera.width = width;
+        scene.camera.height = height;
+    }
+    return scene;
+}
+
 CompareSettings CompareSettings::forQuick(bool quick)
 {
     CompareSettings s;

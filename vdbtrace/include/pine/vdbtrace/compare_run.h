@@ -9,6 +9,7 @@
 #include "pine/vdbtrace/image_diff.h"
 #include "pine/vdbtrace/tree_foliage.h"
 
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
@@ -101,6 +102,15 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& sett
 /// as through any other, so "shadows" and "self_shadowing" come together or not at all:
 /// throws InputError naming the methods that cannot otherwise.
 void checkEffects(const scenes::Effects& effects);
+
+/// The scene a comparison renders (`compare`, `animate-compare`): read, `model` (the command
+/// line's overrides) applied, "self_shadowing" added where the effects name "shadows" if
+/// `addSelfShadowing`, its effects checked (checkEffects), and the camera's resolution
+/// replaced where `width` and `height` are > 0 (fov_deg is vertical: the view is kept, exactly
+/// when the aspect is). Throws what loadScene and checkEffects throw.
+scenes::Scene loadComparedScene(const std::filesystem::path& file,
+                                const std::function<void(scenes::ModelChoices&)>& model,
+                                bool addSelfShadowing, int width, int height);
 
 /// A number for a person: `digits` significant digits.
 std::string formatNumber(double value, int digits = 4);
