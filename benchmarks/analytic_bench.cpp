@@ -32,14 +32,6 @@ const std::vector<Triple>& triples()
     return table;
 }
 
-BoughGeometry paperBough()
-{
-    BoughGeometry b;
-    b.cone = {kPi / 8, 4.25, 0.05, 12};
-    b.coneSpacing_cm = 0.9;
-    return b;
-}
-
 constexpr double kExponent = 200.0;
 
 // Runs `shade` on each triple of the table in turn.

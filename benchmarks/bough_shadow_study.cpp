@@ -11,6 +11,7 @@
 //
 // --segment 0 (the default) is one long bough; the paper fir's boughs are about 6 cm.
 // docs/models.md ("Whole scenes") quotes it.
+#include "pine/analytic/bough_shader.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/geometry_tracer.h"
@@ -27,7 +28,6 @@
 namespace {
 
 using namespace pine::vdbtrace;
-constexpr double kPi = pine::analytic::kPi;
 
 struct Options {
     Vec3 towardsLight{0.2, -0.3, 1.0};
@@ -56,8 +56,7 @@ TracedScene boughs(const Options& o, pine::scenes::Scene& scene, unsigned seed, 
         BoughDescription d;
         d.spec.base_cm = base;
         d.spec.tip_cm = tip;
-        d.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
-        d.spec.needles.coneSpacing_cm = 0.9;
+        d.spec.needles = pine::analytic::paperBough();
         d.seed = rollSeed;
         traced.boughs.push_back(makeTracedBough(d, scene.camera.position_cm, traced.lights,
                                                 boughLaw(scene.render.model.boughLaw),

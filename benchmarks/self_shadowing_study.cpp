@@ -11,6 +11,7 @@
 //   self_shadowing_study [--light X Y Z] [--correlation needles|independent] [--points N]
 //
 // docs/models.md ("Layer correlation") quotes it.
+#include "pine/analytic/bough_shader.h"
 #include "pine/analytic/direction.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/effects_plan.h"
@@ -88,8 +89,7 @@ int main(int argc, char** argv)
         BoughDescription d;
         d.spec.base_cm = Vec3(-100.0, 0.0, 0.0);
         d.spec.tip_cm = Vec3(100.0, 0.0, 0.0);
-        d.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
-        d.spec.needles.coneSpacing_cm = 0.9;
+        d.spec.needles = pine::analytic::paperBough();
         d.seed = 7;
         const TracedBough b = makeTracedBough(d, scene.camera.position_cm, traced.lights,
                                               boughLaw("exact"), layers, {});

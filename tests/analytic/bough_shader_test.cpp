@@ -11,8 +11,6 @@
 namespace pine::analytic {
 namespace {
 
-using test::paperBough;
-
 // A random bough with layer opacity A in [0.01, 0.9] and n A through the axis in [0.01, 5].
 BoughGeometry randomBough(test::RandomDirections& rnd)
 {

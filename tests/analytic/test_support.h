@@ -35,15 +35,6 @@ private:
     std::uniform_real_distribution<double> mUniform{0.0, 1.0};
 };
 
-/// The paper's benchmark bough (section 7): N = 12, r = 0.05, l = 4.25, phi = pi/8, dh = 0.9 cm.
-inline BoughGeometry paperBough()
-{
-    BoughGeometry b;
-    b.cone = {kPi / 8, 4.25, 0.05, 12};
-    b.coneSpacing_cm = 0.9;
-    return b;
-}
-
 /// A rotation of `v` about unit `axis` by `angle`.
 inline Vec3 rotate(const Vec3& v, const Vec3& axis, double angle)
 {

@@ -11,8 +11,6 @@
 namespace pine::analytic {
 namespace {
 
-using test::paperBough;
-
 TEST(TrueConeBough, LayersAreTheConesCountedAlongTheChord)
 {
     // In the plane P_x (distance x from the branch, the z axis), a ray along -V = -(sin, 0, cos)

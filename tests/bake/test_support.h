@@ -3,6 +3,7 @@
 
 #include "../support/temp_dir.h"
 
+#include "pine/analytic/bough_shader.h"
 #include "pine/bake/layer_field.h"
 
 #include <glm/geometric.hpp>
@@ -28,11 +29,7 @@ inline BoughSpec paperBough(const Vec3& base, const Vec3& axis, double length_cm
     BoughSpec b;
     b.base_cm = base;
     b.tip_cm = base + glm::normalize(axis) * length_cm;
-    b.needles.cone.aperture_rad = 3.14159265358979323846 / 8;
-    b.needles.cone.needleLength_cm = 4.25;
-    b.needles.cone.needleRadius_cm = 0.05;
-    b.needles.cone.needlesPerCone = 12;
-    b.needles.coneSpacing_cm = 0.9;
+    b.needles = analytic::paperBough();
     b.needleAlbedo = Vec3(0.135, 0.3, 0.105);
     return b;
 }

@@ -5,6 +5,7 @@
 // panels) must give the same bands, needles and mean depths over random lines through a paper
 // bough with a solid branch: grazing lines, lines through the axis, along it, along the cones'
 // generators, and lines that start inside the bark.
+#include "pine/analytic/bough_shader.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/traced_scene.h"
@@ -130,8 +131,7 @@ TracedBough paperBough(const Vec3& base, const Vec3& tip, double bark)
     BoughDescription desc;
     desc.spec.base_cm = base;
     desc.spec.tip_cm = tip;
-    desc.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
-    desc.spec.needles.coneSpacing_cm = 0.9;
+    desc.spec.needles = analytic::paperBough();
     desc.barkRadius_cm = bark;
     return makeTracedBough(desc, scene.camera.position_cm, traced.lights, *traced.boughLaw,
                            *traced.layers);

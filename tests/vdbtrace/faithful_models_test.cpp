@@ -2,6 +2,7 @@
 // a switch): one long paper bough seen side-on and at 60 and 30 degrees from its branch, each
 // level's mean strip opacity under each layer model and bough law against the geometry
 // method's needles.
+#include "pine/analytic/bough_shader.h"
 #include "pine/bake/tree_grids.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/cone_crossings.h"
@@ -51,8 +52,7 @@ struct LongBough {
         BoughDescription d;
         d.spec.base_cm = -100.0 * axis;
         d.spec.tip_cm = 100.0 * axis;
-        d.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
-        d.spec.needles.coneSpacing_cm = 0.9;
+        d.spec.needles = analytic::paperBough();
         d.seed = seed;
         traced.boughs.push_back(makeTracedBough(
             d, scene.camera.position_cm, traced.lights, boughLaw(model.boughLaw),
@@ -234,8 +234,7 @@ struct RecedingBoughs {
             BoughDescription d;
             d.spec.base_cm = Vec3(-150.0, 0.0, 7.5 - 15.0 * k);
             d.spec.tip_cm = Vec3(150.0, 0.0, 7.5 - 15.0 * k);
-            d.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
-            d.spec.needles.coneSpacing_cm = 0.9;
+            d.spec.needles = analytic::paperBough();
             d.seed = 3 + k;
             traced.boughs.push_back(makeTracedBough(
                 d, scene.camera.position_cm, traced.lights, boughLaw(scene.render.model.boughLaw),
@@ -367,8 +366,7 @@ struct ShadowedBoughs {
             BoughDescription d;
             d.spec.base_cm = Vec3(-100.0, 0.0, 3.0 - 6.0 * k);
             d.spec.tip_cm = Vec3(100.0, 0.0, 3.0 - 6.0 * k);
-            d.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
-            d.spec.needles.coneSpacing_cm = 0.9;
+            d.spec.needles = analytic::paperBough();
             d.seed = seed + 10 * k;
             traced.boughs.push_back(makeTracedBough(
                 d, scene.camera.position_cm, traced.lights,
@@ -505,8 +503,7 @@ TEST(FaithfulModels, TheBarkHidesTheNeedlesRootsAndNothingElse)
     BoughDescription d;
     d.spec.base_cm = Vec3(0.0);
     d.spec.tip_cm = Vec3(12.0, 0.0, 0.0);
-    d.spec.needles.cone = {kPi / 8, 4.25, 0.05, 12};
-    d.spec.needles.coneSpacing_cm = 0.9;
+    d.spec.needles = analytic::paperBough();
     const TracedBough line = makeTracedBough(d, scene.camera.position_cm, traced.lights,
                                              *traced.boughLaw, *traced.layers);
     d.barkRadius_cm = 0.4;

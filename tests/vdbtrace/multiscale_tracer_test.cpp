@@ -312,8 +312,7 @@ struct SideOnBough {
         BoughDescription d;
         d.spec.base_cm = Vec3(-40, 0, 0);
         d.spec.tip_cm = Vec3(40, 0, 0);
-        d.spec.needles.cone = {analytic::kPi / 8, 4.25, 0.05, 12};
-        d.spec.needles.coneSpacing_cm = 0.9;
+        d.spec.needles = analytic::paperBough();
         traced.boughs.push_back(
             makeTracedBough(d, scene.camera.position_cm, traced.lights, law, *traced.layers));
         indexPrimitives(traced);

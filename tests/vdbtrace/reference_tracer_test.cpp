@@ -46,8 +46,7 @@ struct SideOn {
         const Vec3 axis(std::cos(tilt_rad), std::sin(tilt_rad), 0);
         d.spec.base_cm = -20.0 * axis;
         d.spec.tip_cm = 20.0 * axis;
-        d.spec.needles.cone = {analytic::kPi / 8, 4.25, 0.05, 12};
-        d.spec.needles.coneSpacing_cm = 0.9;
+        d.spec.needles = analytic::paperBough();
         d.spec.needleAlbedo = Vec3(0.3);
         traced.boughs.push_back(
             makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear"),

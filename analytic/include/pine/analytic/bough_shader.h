@@ -18,6 +18,13 @@ struct BoughGeometry {
     double coneSpacing_cm = 0.9;  ///< dh, distance between successive cones along the branch
 };
 
+/// The paper's benchmark bough (section 7): N = 12, r = 0.05 cm, l = 4.25 cm, phi = pi/8,
+/// dh = 0.9 cm.
+inline BoughGeometry paperBough()
+{
+    return {{kPi / 8, 4.25, 0.05, 12}, 0.9};
+}
+
 /// k(phi_r, phi) from phi_r's cosine c and sine s; +inf for a ray along the branch (s = 0).
 double layerRate(double aperture_rad, double c, double s);
 /// kbar = k(phi_r, pi - phi).
