@@ -13,17 +13,19 @@
 // docs/models.md ("Whole scenes") quotes it.
 #include "pine/analytic/bough_shader.h"
 #include "pine/scenes/scene.h"
+#include "pine/support/tool_main.h"
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/traced_scene.h"
 
-#include <cmath>
+#include "study_options.h"
+
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace {
 
@@ -91,57 +93,33 @@ std::pair<double, double> halves(const RenderResult& r)
     return {lower, upper};
 }
 
-int usage(const std::string& problem)
-{
-    std::fprintf(stderr,
-                 "bough_shadow_study: %s\nusage: bough_shadow_study [--light X Y Z] [--segment "
-                 "CM] [--rolls N] [--shadow-origin needles|bough]\n",
-                 problem.c_str());
-    return 2;
-}
-
 }  // namespace
 
 int main(int argc, char** argv)
 {
+    CLI::App app{
+        "One bough's shadow on another, the occluder one long bough or a chain of short "
+        "ones: the explicit needles against levels 1-3 (docs/models.md)"};
+    std::vector<double> light{0.2, -0.3, 1.0};
+    pine::study::addLightOption(app, light);
     Options o;
-    for (int a = 1; a < argc; ++a) {
-        const std::string arg = argv[a];
-        if (arg == "--help" || arg == "-h") {
-            std::printf(
-                "One bough's shadow on another, the occluder one long bough or a chain of "
-                "short ones: the explicit needles against levels 1-3.\nusage: "
-                "bough_shadow_study [--light X Y Z] [--segment CM] [--rolls N] "
-                "[--shadow-origin needles|bough]\n");
-            return 0;
+    app.add_option("--segment", o.segment_cm,
+                   "Cut the upper bough into a chain of boughs this long, cm (0: one bough)")
+        ->capture_default_str();
+    app.add_option("--rolls", o.rolls, "Needle rolls the explicit needles are averaged over")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
+    std::string origin = "needles";
+    app.add_option("--shadow-origin", origin, "The multiscale levels' render.shadow_origin")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"needles", "bough"}));
+    return pine::tool::run("bough_shadow_study", app, argc, argv, [&] {
+        pine::study::lightDirection(light);  // checked; the scene file normalises it
+        o.towardsLight = Vec3(light[0], light[1], light[2]);
+        o.origin = origin == "bough" ? ShadowOrigin::Bough : ShadowOrigin::Needles;
+        if (!(o.segment_cm == 0.0 || (o.segment_cm >= 1.0 && o.segment_cm <= 200.0))) {
+            throw pine::InputError("--segment must be 0 (one bough) or 1 to 200 cm");
         }
-        if (arg == "--light" && a + 3 < argc) {
-            for (int k = 0; k < 3; ++k) o.towardsLight[k] = std::strtod(argv[++a], nullptr);
-        } else if (arg == "--segment" && a + 1 < argc) {
-            o.segment_cm = std::strtod(argv[++a], nullptr);
-        } else if (arg == "--rolls" && a + 1 < argc) {
-            o.rolls = std::atoi(argv[++a]);
-        } else if (arg == "--shadow-origin" && a + 1 < argc) {
-            const std::string origin = argv[++a];
-            if (origin != "needles" && origin != "bough") {
-                return usage("--shadow-origin is needles or bough, not " + origin);
-            }
-            o.origin = origin == "bough" ? ShadowOrigin::Bough : ShadowOrigin::Needles;
-        } else {
-            return usage("unknown or incomplete option " + arg);
-        }
-    }
-    const double length =
-        std::sqrt(o.towardsLight.x * o.towardsLight.x + o.towardsLight.y * o.towardsLight.y +
-                  o.towardsLight.z * o.towardsLight.z);
-    if (!(length > 0.0) || !std::isfinite(length)) {
-        return usage("the light's direction must be finite and not zero");
-    }
-    if (!(o.segment_cm == 0.0 || (o.segment_cm >= 1.0 && o.segment_cm <= 200.0))) {
-        return usage("--segment must be 0 (one bough) or 1 to 200 cm");
-    }
-    if (o.rolls < 1 || o.rolls > 64) return usage("--rolls must be 1 to 64");
-    try {
         pine::scenes::Scene scene;
         double through = 0.0, upper = 0.0;
         for (int roll = 1; roll <= o.rolls; ++roll) {
@@ -170,9 +148,6 @@ int main(int argc, char** argv)
                 "needles'\n",
                 level, lo / alone, up / upper);
         }
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "bough_shadow_study: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+        return 0;
+    });
 }

@@ -14,69 +14,49 @@
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/direction.h"
 #include "pine/scenes/scene.h"
+#include "pine/support/tool_main.h"
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/geometry.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/needle_layout.h"
 #include "pine/vdbtrace/traced_scene.h"
 
+#include "study_options.h"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <random>
 #include <string>
+#include <vector>
 
 namespace {
 
 using pine::vdbtrace::Vec3;
 constexpr double kPi = pine::analytic::kPi;
 
-int usage(const char* problem)
-{
-    std::fprintf(stderr,
-                 "self_shadowing_study: %s\nusage: self_shadowing_study [--light X Y Z] "
-                 "[--correlation needles|independent] [--points N]\n",
-                 problem);
-    return 2;
-}
-
 }  // namespace
 
 int main(int argc, char** argv)
 {
     using namespace pine::vdbtrace;
-    Vec3 towardsLight(0.3, -1.0, 0.6);  // the camera's side, above: the test's first light
+    CLI::App app{
+        "The layer model's self-shadowing against shadow rays through the explicit "
+        "needles, point by point, on one long paper bough side-on (docs/models.md)"};
+    std::vector<double> light{0.3, -1.0, 0.6};  // the camera's side, above: the test's first light
+    pine::study::addLightOption(app, light);
     std::string correlation = "needles";
+    app.add_option("--correlation", correlation, "The layer model's layer_correlation")
+        ->capture_default_str()
+        ->check(CLI::IsMember(layerCorrelationNames()));
     long points = 400000;
-    for (int a = 1; a < argc; ++a) {
-        const std::string arg = argv[a];
-        if (arg == "--help" || arg == "-h") {
-            std::printf(
-                "The layer model's self-shadowing against shadow rays through the explicit "
-                "needles, point by point, on one long paper bough side-on (camera along "
-                "+y).\nusage: self_shadowing_study [--light X Y Z] [--correlation "
-                "needles|independent] [--points N]\n");
-            return 0;
-        }
-        if (arg == "--light" && a + 3 < argc) {
-            for (int k = 0; k < 3; ++k) towardsLight[k] = std::strtod(argv[++a], nullptr);
-        } else if (arg == "--correlation" && a + 1 < argc) {
-            correlation = argv[++a];
-        } else if (arg == "--points" && a + 1 < argc) {
-            points = std::strtol(argv[++a], nullptr, 10);
-        } else {
-            return usage(("unknown or incomplete option " + arg).c_str());
-        }
-    }
-    if (!(glm::length(towardsLight) > 0.0) || !std::isfinite(glm::length(towardsLight))) {
-        return usage("the light's direction must be finite and not zero");
-    }
-    if (points < 1000 || points > 100000000) return usage("--points must be 1000 to 1e8");
-    try {
-        const Vec3 L = glm::normalize(towardsLight), V(0.0, -1.0, 0.0);
+    app.add_option("--points", points, "Random points on the needles")
+        ->capture_default_str()
+        ->check(CLI::Range(1000L, 100000000L));
+    return pine::tool::run("self_shadowing_study", app, argc, argv, [&] {
+        const Vec3 L = pine::study::lightDirection(light), V(0.0, -1.0, 0.0);
         const LayerModel& layers = layerModel("fibre", layerCorrelated(correlation));
         // The test's bough: N 12, r 0.05, l 4.25, phi pi/8, dh 0.9, 200 cm along x, seen from -y.
         const pine::scenes::Scene scene = pine::scenes::parseScene(R"({"name": "study",
@@ -165,9 +145,6 @@ int main(int argc, char** argv)
         }
         std::printf("%-16s %8.3f %10.4f %10.4f %8.3f\n", "all", W / double(points), R / W, M / W,
                     M / R);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "self_shadowing_study: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+        return 0;
+    });
 }
