@@ -19,6 +19,18 @@ std::string shown(double v)
     return formatNumber(v, 3);
 }
 
+// A breakdown's table cells: all pixels, then each level band ("-" where it has no pixels),
+// each " value |".
+std::string breakdownCells(const FlickerBreakdown& f)
+{
+    std::ostringstream cells;
+    cells << ' ' << shown(f.flicker) << " |";
+    for (std::size_t b = 0; b < f.perBand.size(); ++b) {
+        cells << ' ' << (f.bandPixels[b] > 0 ? shown(f.perBand[b]) : std::string("-")) << " |";
+    }
+    return cells.str();
+}
+
 // A path's pixels change along curves (a trunk sweeping across them): each frame is measured
 // against its neighbours' line (flicker.h).
 constexpr int kPathWindow = 3;
@@ -111,13 +123,8 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
     for (std::size_t b = 0; b < std::size(kLevelBandNames); ++b) md << "---|";
     md << "---|---|\n";
     for (const AnimationRow& r : a.rows) {
-        md << "| " << r.method << " | " << shown(r.flicker.flicker) << " |";
-        for (std::size_t b = 0; b < r.flicker.perBand.size(); ++b) {
-            md << ' '
-               << (r.flicker.bandPixels[b] > 0 ? shown(r.flicker.perBand[b]) : std::string("-"))
-               << " |";
-        }
-        md << ' ' << shown(r.secondsPerFrame) << " | " << shown(r.cpuSecondsPerFrame) << " |\n";
+        md << "| " << r.method << " |" << breakdownCells(r.flicker) << ' '
+           << shown(r.secondsPerFrame) << " | " << shown(r.cpuSecondsPerFrame) << " |\n";
     }
     md << "| pixels in the band | " << std::size_t(a.width) * a.height << " |";
     for (const std::size_t n : a.rows.front().flicker.bandPixels) md << ' ' << n << " |";
@@ -147,14 +154,7 @@ std::string reportMd(const AnimationFlicker& a, const AnimationCompareOptions& o
         md << "\n";
         for (const AnimationRow& r : a.rows) {
             if (!r.errorFlicker) continue;
-            md << "| " << r.method << " | " << shown(r.errorFlicker->flicker) << " |";
-            for (std::size_t b = 0; b < r.errorFlicker->perBand.size(); ++b) {
-                md << ' '
-                   << (r.errorFlicker->bandPixels[b] > 0 ? shown(r.errorFlicker->perBand[b])
-                                                         : std::string("-"))
-                   << " |";
-            }
-            md << "\n";
+            md << "| " << r.method << " |" << breakdownCells(*r.errorFlicker) << "\n";
         }
         md << "\n";
         for (std::size_t m = 1; m < a.rows.size(); ++m) {
