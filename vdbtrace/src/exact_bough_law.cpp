@@ -124,7 +124,7 @@ public:
             lit[h] = diffuse[h] = specular[h] = std::vector<Cells>(lights, Cells(kCells, 0.0));
         }
         // Opacities are even in the offset: with no light to shade, half the cells do.
-        forEachShownLayer(b, V, layers, lights > 0, [&](const ShownLayer& shown) {
+        const auto shade = [&](const ShownLayer& shown) {
             alpha[shown.half][shown.cell] += shown.share;
             if (shown.share <= 0.0) return;
             double rho;
@@ -133,9 +133,7 @@ public:
             const Vec3 needle = cosPhi * b.axis + sinPhi * radial;  // as at level 2
             for (std::size_t i = 0; i < lights; ++i) {
                 const Vec3& L = towardsLights[i];
-                const double seen =
-                    shown.share *
-                    (needs.transfer ? layers.transmittance(b, shown.x, L, shown.cone, V) : 1.0);
+                const double seen = shown.share * (needs.transfer ? shown.lit[i] : 1.0);
                 lit[shown.half][i][shown.cell] += seen;
                 if (needs.diffuse) {
                     diffuse[shown.half][i][shown.cell] +=
@@ -146,7 +144,9 @@ public:
                         seen * analytic::needleSpecular(needle, L, V, b.exponent);
                 }
             }
-        });
+        };
+        const std::vector<Vec3> none;
+        forEachShownLayer(b, V, layers, lights > 0, needs.transfer ? towardsLights : none, shade);
         for (int k = kCells / 2; k < kCells && lights == 0; ++k) {
             alpha[0][k] = alpha[0][kCells - 1 - k];
             alpha[1][k] = alpha[1][kCells - 1 - k];
@@ -215,7 +215,7 @@ public:
         const auto at = [&](int half, int cell, int bin) -> double& {
             return seen[(std::size_t(half) * kCells + std::size_t(cell)) * bins + bin];
         };
-        forEachShownLayer(b, V, layers, true, [&](const ShownLayer& shown) {
+        forEachShownLayer(b, V, layers, true, {}, [&](const ShownLayer& shown) {
             Vec3 radial;
             coneHeight(b, cotPhi, shown.x, nullptr, &radial);
             const double psi = std::atan2(glm::dot(radial, b.across), glm::dot(radial, ev));
@@ -238,34 +238,54 @@ public:
 
 private:
     // A layer a chord of the view meets and what of it shows: its share of the chord's
-    // transmittance times the chord's weight, in half `half` (0 front, 1 rear) of cell `cell`.
+    // transmittance times the chord's weight, in half `half` (0 front, 1 rear) of cell `cell`;
+    // lit[i] the light from the i-th direction forEachShownLayer was asked for that reaches it
+    // through the bough (its self-shadowing).
     struct ShownLayer {
         int half, cell;
         double share;
         Vec3 x;
         long cone;
+        const double* lit;
     };
     // Every layer the view's chords meet along -V, cell by cell (the first half of the cells
-    // only unless `allCells`), until the chord is opaque.
+    // only unless `allCells`), until the chord is opaque, lit from each of `towardsLights`.
     template <class Visit>
     void forEachShownLayer(const TracedBough& b, const Vec3& V, const LayerModel& layers,
-                           bool allCells, Visit&& visit) const
+                           bool allCells, const std::vector<Vec3>& towardsLights,
+                           Visit&& visit) const
     {
         const Vec3 d = -V;
+        const std::size_t lights = towardsLights.size();
+        thread_local std::vector<LayerHit> hits;
+        thread_local std::vector<double> lit, fromOne;  // lit: hit-major, a value per light
         for (int k = 0; k < (allCells ? kCells : kCells / 2); ++k) {
             for (int p = 0; p < mShadingChords.count; ++p) {
                 Vec3 o;
                 double tIn, tOut, weight;
                 if (!chord(b, d, b.across, k, p, mShadingChords, o, tIn, tOut, weight)) continue;
-                const double tMid = 0.5 * (tIn + tOut);
+                hits.clear();
                 double T = 1.0;
                 layers.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
+                    hits.push_back(hit);
+                    T *= 1.0 - hit.opacity;
+                    return T >= kOpaque;
+                });
+                // The chord's layers in front of each are those the view's line met.
+                lit.resize(hits.size() * lights);
+                for (std::size_t i = 0; i < lights; ++i) {
+                    layers.transmittancesAlong(b, o, d, hits, towardsLights[i], fromOne);
+                    for (std::size_t h = 0; h < hits.size(); ++h) lit[h * lights + i] = fromOne[h];
+                }
+                const double tMid = 0.5 * (tIn + tOut);
+                T = 1.0;
+                for (std::size_t h = 0; h < hits.size(); ++h) {
+                    const LayerHit& hit = hits[h];
                     const double share = T * hit.opacity;  // what this layer shows
                     T *= 1.0 - hit.opacity;
                     visit(ShownLayer{hit.t < tMid ? 0 : 1, k, share * weight, o + hit.t * d,
-                                     hit.cone});
-                    return T >= kOpaque;
-                });
+                                     hit.cone, lit.data() + h * lights});
+                }
             }
         }
     }

@@ -108,7 +108,12 @@ public:
                          long ownCone, const Vec3& towardsViewer) const override
     {
         if (mCorrelated && glm::dot(towardsViewer, towardsViewer) > 0.0) {
-            return correlated(b, x, towardsLight, ownCone, towardsViewer);
+            thread_local std::vector<Arc> light, view;
+            const double period = needlePeriod(b);
+            arcsAlong(b, x, towardsLight, ownCone, period, light);
+            if (light.empty()) return 1.0;
+            arcsAlong(b, x, towardsViewer, ownCone, period, view);
+            return conditioned(light, view, period);
         }
         double transmittance = 1.0;
         forEachBandFrom(b, x, towardsLight, ownCone, [&](const ConeBand& band) {
@@ -118,35 +123,81 @@ public:
         return transmittance;
     }
 
+    // The view's arcs are the layers the line met in front of each needle: each layer's arc
+    // once, where walking the view's line back from every needle took a walk a needle.
+    void transmittancesAlong(const TracedBough& b, const Vec3& o, const Vec3& d,
+                             const std::vector<LayerHit>& hits, const Vec3& towardsLight,
+                             std::vector<double>& out) const override
+    {
+        if (!mCorrelated) return LayerModel::transmittancesAlong(b, o, d, hits, towardsLight, out);
+        thread_local std::vector<Arc> light, view;
+        const double period = needlePeriod(b);
+        const Azimuths azimuths(b);
+        out.resize(hits.size());
+        view.clear();
+        for (std::size_t k = 0; k < hits.size(); ++k) {
+            const LayerHit& hit = hits[k];
+            const Vec3 x = o + hit.t * d;
+            arcsAlong(b, x, towardsLight, hit.cone, period, light);
+            out[k] = light.empty() ? 1.0 : conditioned(light, view, period);
+            if (hit.opacity > 0.0) view.push_back(azimuths.arc(hit.cone, x, hit.opacity, period));
+        }
+    }
+
 private:
+    // The period of a cone's needles in azimuth (radians).
+    static double needlePeriod(const TracedBough& b)
+    {
+        return 2.0 * analytic::kPi / std::max(1.0, std::round(b.geometry.cone.needlesPerCone));
+    }
+
+    // Azimuths about b's axis, in one frame for every line through b.
+    class Azimuths {
+    public:
+        explicit Azimuths(const TracedBough& b)
+            : mBough(b),
+              mCotPhi(apertureTrig(b.geometry.cone.aperture_rad).oneOverTan),
+              mE1(analytic::anyPerpendicular(b.axis)),
+              mE2(glm::cross(b.axis, mE1))
+        {
+        }
+        /// The arc of cone `cone`'s needles a line meets about x, stopped there with
+        /// probability `opacity` (min(1, n) of its band).
+        Arc arc(long cone, const Vec3& x, double opacity, double period) const
+        {
+            Vec3 radial;
+            coneHeight(mBough, mCotPhi, x, nullptr, &radial);
+            const double azimuth = std::atan2(glm::dot(radial, mE2), glm::dot(radial, mE1));
+            const double width = opacity * period;
+            return {cone, azimuth - 0.5 * width, width};
+        }
+
+    private:
+        const TracedBough& mBough;
+        double mCotPhi;
+        Vec3 mE1, mE2;
+    };
+
     // The arcs of the line from x along d (forEachBandFrom's bands).
     static void arcsAlong(const TracedBough& b, const Vec3& x, const Vec3& d, long ownCone,
                           double period, std::vector<Arc>& out)
     {
         out.clear();
-        const double cotPhi = apertureTrig(b.geometry.cone.aperture_rad).oneOverTan;
-        const Vec3 e1 = analytic::anyPerpendicular(b.axis), e2 = glm::cross(b.axis, e1);
+        const Azimuths azimuths(b);
         forEachBandFrom(b, x, d, ownCone, [&](const ConeBand& band) {
             if (!(band.needles > 0.0)) return true;
-            Vec3 radial;
-            coneHeight(b, cotPhi, x + band.t * d, nullptr, &radial);
-            const double azimuth = std::atan2(glm::dot(radial, e2), glm::dot(radial, e1));
-            const double width = std::min(1.0, band.needles) * period;
-            out.push_back({band.cone, azimuth - 0.5 * width, width});
+            out.push_back(
+                azimuths.arc(band.cone, x + band.t * d, std::min(1.0, band.needles), period));
             return true;
         });
     }
 
-    double correlated(const TracedBough& b, const Vec3& x, const Vec3& towardsLight,
-                      long ownCone, const Vec3& towardsViewer) const
+    // The light's transmittance along its arcs `light` (reordered), conditioned cone by cone
+    // on the view's line, whose arcs `view` missed every needle.
+    static double conditioned(std::vector<Arc>& light, const std::vector<Arc>& view, double period)
     {
-        thread_local std::vector<Arc> view, light, cone;
+        thread_local std::vector<Arc> cone;
         thread_local std::vector<std::pair<double, double>> pieces;
-        const double N = std::max(1.0, std::round(b.geometry.cone.needlesPerCone));
-        const double period = 2.0 * analytic::kPi / N;
-        arcsAlong(b, x, towardsLight, ownCone, period, light);
-        if (light.empty()) return 1.0;
-        arcsAlong(b, x, towardsViewer, ownCone, period, view);
         std::sort(light.begin(), light.end(),
                   [](const Arc& a, const Arc& c) { return a.cone < c.cone; });
         double transmittance = 1.0;

@@ -35,6 +35,16 @@ const Registry<const bool>& correlations()
 
 }  // namespace
 
+void LayerModel::transmittancesAlong(const TracedBough& b, const Vec3& o, const Vec3& d,
+                                     const std::vector<LayerHit>& hits, const Vec3& towardsLight,
+                                     std::vector<double>& out) const
+{
+    out.resize(hits.size());
+    for (std::size_t k = 0; k < hits.size(); ++k) {
+        out[k] = transmittance(b, o + hits[k].t * d, towardsLight, hits[k].cone, -d);
+    }
+}
+
 const LayerModel& layerModel(const std::string& name, bool correlated)
 {
     return registry(correlated).get(name);

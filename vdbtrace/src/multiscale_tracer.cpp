@@ -51,12 +51,15 @@ private:
     // signed offset xi from the axis.
     void addCrossings(const ConeRay& ray, std::size_t index, const TracedBough& b, double tIn,
                       double tOut, double coverage, double xi, double w, Level level);
-    // A needle of cone `cone` the ray meets at depth t, of which the pixel sees alpha.
+    // A needle of cone `cone` the ray meets at depth t, of which the pixel sees alpha; at
+    // level 2, the layer of mLayerHits it stands for.
     struct NeedleHit {
         long cone;
         Vec3 needle;
         double t, alpha;
+        std::size_t layer = kNoLayer;
     };
+    static constexpr std::size_t kNoLayer = std::size_t(-1);
     // Shades mNeedleHits (levels 1-2): each needle's light through the bough's other layers
     // under the layer model (section 6's self-shadowing, counted, not approximated) and
     // through the scene from where the needles lie.
@@ -100,6 +103,7 @@ private:
     NearestFirstQueue mQueue;  ///< the primitives the ray may yet meet
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
+    std::vector<double> mLayerLit;                    ///< their self-shadowing from one light
     std::vector<NeedleHit> mNeedleHits;               ///< a bough's needles on this ray
     std::vector<std::size_t> mByDepth;                ///< their indices, front to back
     std::vector<double> mSelf;       ///< their self-shadowing, hit-major, one per light
@@ -188,7 +192,17 @@ void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
         mLight[i] = mSurfaces.unshadowed(i, ray.origin + tRef * ray.direction);
     }
     mSelf.assign(hits * lights, 1.0);
-    if (mPlan.selfShadowing) {
+    if (mPlan.selfShadowing && level == 2) {
+        // Each layer seen through those the ray met in front of it.
+        for (std::size_t i = 0; i < lights; ++i) {
+            mScene.layers->transmittancesAlong(b, ray.origin, ray.direction, mLayerHits,
+                                               mLight[i].towards, mLayerLit);
+            for (std::size_t h = 0; h < hits; ++h) {
+                ++mStats.selfShadowEvaluations;
+                mSelf[h * lights + i] = mLayerLit[mNeedleHits[h].layer];
+            }
+        }
+    } else if (mPlan.selfShadowing) {
         for (std::size_t h = 0; h < hits; ++h) {
             const Vec3 x = ray.origin + mNeedleHits[h].t * ray.direction;
             for (std::size_t i = 0; i < lights; ++i) {
@@ -290,7 +304,8 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
                 alpha = covered < 1.0 ? share / (1.0 - covered) : 0.0;
                 covered += share;
             }
-            mNeedleHits.push_back({hit.cone, cosPhi * b.axis + sinPhi * radial, hit.t, alpha});
+            mNeedleHits.push_back({hit.cone, cosPhi * b.axis + sinPhi * radial, hit.t, alpha,
+                                   std::size_t(&hit - mLayerHits.data())});
         }
         // At the strip's edge one line stands for a footprint across which the bough thins:
         // its layers' coverage times the line's opacity is not the footprint's mean, and

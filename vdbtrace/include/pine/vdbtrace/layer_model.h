@@ -35,6 +35,17 @@ public:
     /// layer correlation; a zero vector: not seen, or not known).
     virtual double transmittance(const TracedBough& b, const Vec3& x, const Vec3& towardsLight,
                                  long ownCone, const Vec3& towardsViewer) const = 0;
+    /// transmittance() for every needle a viewing line meets: `hits` are the layers of b that
+    /// the line o + t d (d unit, from the viewer) met, front to back, as layers() gave them;
+    /// out[k] is the light from unit `towardsLight` that reaches hits[k]'s needles at
+    /// o + hits[k].t d, seen through hits[0, k) (towardsViewer -d). This base calls
+    /// transmittance() for each; a model that conditions on the view's line reads that line's
+    /// layers from `hits` in place of walking it again from every needle, the same bands
+    /// integrated over panels placed from the line's entry rather than from each needle (so
+    /// the two agree to the bands' quadrature, cone_crossings.h).
+    virtual void transmittancesAlong(const TracedBough& b, const Vec3& o, const Vec3& d,
+                                     const std::vector<LayerHit>& hits, const Vec3& towardsLight,
+                                     std::vector<double>& out) const;
 };
 
 /// The model registered as `name`, its crossings of one cone `correlated` or not (see
