@@ -232,31 +232,36 @@ TEST(ConeBands, TheClosedFormWalksTheBandsAFineMarchFinds)
 
 // LayerModel::transmittancesAlong reads the view's side of the layer correlation from the
 // line's own layers, where transmittance() walks the view's line back from each needle: the
-// same bands, their panels placed from the line's entry rather than from the needle. Over
-// random lines through a paper bough with a branch and random lights (a third of them within
-// 10 degrees of the view, where the conditioning matters most), every model gives each needle
-// the light transmittance() gives it, to the bands' quadrature. Without the view's layers (the
-// independent model's answer in place of the correlated one's) the worst needle differs by
-// far more: the comparison can tell.
+// same bands, each integrated from its other edge. Over random lines through a paper bough
+// with a branch (started outside it, as the tracer's lines and the exact law's chords are),
+// lit from random directions and from 0, 1, 3 and 10 degrees off the view (the hot spot,
+// where the conditioning divides by what the view's arcs leave and so magnifies their
+// quadrature), every model gives each needle the light transmittance() gives it, and each
+// line the same light over its needles weighted by what the line shows of them (what a
+// render sums). Without the view's layers (the independent model's answer in place of the
+// correlated one's) a line's light differs by far more: the comparison can tell.
 TEST(LayerCorrelation, ALinesOwnLayersConditionEachNeedleAsAWalkFromItDoes)
 {
     const TracedBough b = paperBough(Vec3(0.0), Vec3(10.0, 0.0, 0.0), 0.3);
     const double R = b.radius_cm;
     std::mt19937 rng(29);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
-    double worst[3] = {0.0, 0.0, 0.0}, unconditioned = 0.0, sum = 0.0;
-    int needles = 0;
+    double worstNeedle[3] = {0.0, 0.0, 0.0}, worstLine = 0.0, unconditioned = 0.0;
+    int needles = 0, lines = 0;
     std::vector<LayerHit> hits;
     std::vector<double> along;
-    for (int k = 0; k < 300; ++k) {
+    for (int k = 0; k < 400; ++k) {
         const Vec3 d = glm::normalize(Vec3(u(rng), u(rng), u(rng)));
         const Vec3 at(5.0 + 6.0 * u(rng), R * u(rng), R * u(rng));
-        Vec3 L = glm::normalize(Vec3(u(rng), u(rng), u(rng)));
-        if (k % 3 == 0)
-            L = glm::normalize(-d + 0.17 * glm::normalize(Vec3(u(rng), u(rng), u(rng))));
+        const Vec3 side = glm::normalize(glm::cross(d, Vec3(u(rng), u(rng), u(rng))));
+        constexpr double kOffView[4] = {0.0, 1.0, 3.0, 10.0};  // degrees
+        const double off = kOffView[k % 4] * kPi / 180.0;
+        const Vec3 L = k % 5 == 4 ? glm::normalize(Vec3(u(rng), u(rng), u(rng)))
+                                  : std::cos(off) * -d + std::sin(off) * side;
         const Vec3 o = at - 40.0 * d;
         double tIn, tOut;
         if (!layeredInterval(b, o, d, tIn, tOut)) continue;
+        ++lines;
         int m = 0;
         for (const auto& [name, c] :
              {std::pair{"fibre", true}, std::pair{"fibre", false}, std::pair{"paper", false}}) {
@@ -268,30 +273,40 @@ TEST(LayerCorrelation, ALinesOwnLayersConditionEachNeedleAsAWalkFromItDoes)
             });
             model.transmittancesAlong(b, o, d, hits, L, along);
             ASSERT_EQ(along.size(), hits.size());
+            double T = 1.0, sumAlong = 0.0, sumWalked = 0.0, sumAlone = 0.0, shown = 0.0;
             for (std::size_t h = 0; h < hits.size(); ++h) {
                 const Vec3 x = o + hits[h].t * d;
                 const double walked = model.transmittance(b, x, L, hits[h].cone, -d);
-                EXPECT_NEAR(along[h], walked, 1e-3) << name << " line " << k << " layer " << h;
-                worst[m] = std::max(worst[m], std::abs(along[h] - walked));
+                EXPECT_NEAR(along[h], walked, 5e-2) << name << " line " << k << " layer " << h;
+                worstNeedle[m] = std::max(worstNeedle[m], std::abs(along[h] - walked));
+                const double share = T * hits[h].opacity;
+                T *= 1.0 - hits[h].opacity;
+                shown += share;
+                sumAlong += share * along[h];
+                sumWalked += share * walked;
                 if (m == 0) {
                     ++needles;
-                    sum += std::abs(along[h] - walked);
-                    const double alone =
-                        layerModel("fibre", false).transmittance(b, x, L, hits[h].cone, -d);
-                    unconditioned = std::max(unconditioned, std::abs(alone - walked));
+                    sumAlone +=
+                        share * layerModel("fibre", false).transmittance(b, x, L, hits[h].cone, -d);
                 }
+            }
+            if (m == 0 && shown > 0.0) {
+                EXPECT_NEAR(sumAlong / shown, sumWalked / shown, 2e-3) << "line " << k;
+                worstLine = std::max(worstLine, std::abs(sumAlong - sumWalked) / shown);
+                unconditioned = std::max(unconditioned, std::abs(sumAlone - sumWalked) / shown);
             }
             ++m;
         }
     }
     std::printf(
-        "%d needles: worst difference fibre correlated %.2e (mean %.2e), independent "
-        "%.2e, paper %.2e; the view's conditioning itself up to %.2f\n",
-        needles, worst[0], sum / std::max(needles, 1), worst[1], worst[2], unconditioned);
-    EXPECT_GT(needles, 1000);
-    EXPECT_EQ(worst[1], 0.0);  // the base's loop: transmittance() itself
-    EXPECT_EQ(worst[2], 0.0);
-    EXPECT_GT(unconditioned, 100 * worst[0]);
+        "%d lines, %d needles: the line's layers against a walk from each needle: worst "
+        "needle %.2e (independent %.2e, paper %.2e), worst line's light %.2e; the view's "
+        "conditioning itself moves a line's light by up to %.2f\n",
+        lines, needles, worstNeedle[0], worstNeedle[1], worstNeedle[2], worstLine, unconditioned);
+    EXPECT_GT(needles, 1500);
+    EXPECT_EQ(worstNeedle[1], 0.0);  // the base's loop: transmittance() itself
+    EXPECT_EQ(worstNeedle[2], 0.0);
+    EXPECT_GT(unconditioned, 50 * worstLine);
 }
 
 // g along a line is concave: it rises to ConeLine::turn and falls after, and ConeLine::level

@@ -23,9 +23,10 @@ class LayerModel {
 public:
     virtual ~LayerModel() = default;
     /// Calls visit for every layer of b that the line o + t d (d unit) meets for t in
-    /// [tIn, tOut], until it returns false (a line gone opaque needs no more); each layer's
-    /// needles are independent of every other layer's (each cone has its own roll,
-    /// needle_layout.h).
+    /// [tIn, tOut], in order along it (transmittancesAlong reads the layers before a needle
+    /// as those the view's line met), until it returns false (a line gone opaque needs no
+    /// more); each layer's needles are independent of every other layer's (each cone has its
+    /// own roll, needle_layout.h).
     virtual void layers(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn,
                         double tOut, const std::function<bool(const LayerHit&)>& visit) const = 0;
     /// The light that reaches x on a needle of cone `ownCone` from unit direction
@@ -40,9 +41,13 @@ public:
     /// out[k] is the light from unit `towardsLight` that reaches hits[k]'s needles at
     /// o + hits[k].t d, seen through hits[0, k) (towardsViewer -d). This base calls
     /// transmittance() for each; a model that conditions on the view's line reads that line's
-    /// layers from `hits` in place of walking it again from every needle, the same bands
-    /// integrated over panels placed from the line's entry rather than from each needle (so
-    /// the two agree to the bands' quadrature, cone_crossings.h).
+    /// layers from `hits` in place of walking it again from every needle. They are the same
+    /// bands, each integrated from the edge the line enters it by rather than the other, so
+    /// the two agree to the bands' quadrature (cone_crossings.h), which the conditioning
+    /// magnifies near the hot spot (a light within a degree of the view: a needle's light up
+    /// to 2e-2 lower, the line's mean 1e-5); and where the line starts inside b (a viewer
+    /// among the needles) only the layers in front of the viewer count, where a walk back
+    /// from the needle went on behind the viewer.
     virtual void transmittancesAlong(const TracedBough& b, const Vec3& o, const Vec3& d,
                                      const std::vector<LayerHit>& hits, const Vec3& towardsLight,
                                      std::vector<double>& out) const;
