@@ -309,6 +309,83 @@ TEST(LayerCorrelation, ALinesOwnLayersConditionEachNeedleAsAWalkFromItDoes)
     EXPECT_GT(unconditioned, 50 * worstLine);
 }
 
+// LayerModel::transmittancesAt, level 1's: needles anywhere on a line, each read through the
+// line's layers before its band where a walk back from it would leave that band out as its
+// own, else by that walk. Points near every layer of random lines (a needle's passage lies
+// near its cone's sheet) and some in a neighbouring cone's band, some beyond the bough, some
+// on lines through the branch, lit from 0, 5 and 10 degrees off the view and from random
+// directions: every model gives each needle what transmittance() gives it, to the bands'
+// quadrature, and the needles that must walk back (another cone's band, outside the bough)
+// get its very bits.
+TEST(LayerCorrelation, NeedlesAnywhereOnALineReadTheLayersBeforeTheirBand)
+{
+    const TracedBough b = paperBough(Vec3(0.0), Vec3(10.0, 0.0, 0.0), 0.3);
+    const double R = b.radius_cm;
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    double worst[3] = {0.0, 0.0, 0.0};
+    int needles = 0, walkedBack = 0;
+    std::vector<LayerHit> hits;
+    std::vector<LayerModel::NeedleOnLine> points;
+    std::vector<double> at;
+    for (int k = 0; k < 300; ++k) {
+        const Vec3 d = glm::normalize(Vec3(u(rng), u(rng), u(rng)));
+        Vec3 through(5.0 + 6.0 * u(rng), R * u(rng), R * u(rng));
+        if (k % 4 == 1) through.y = through.z = 0.1 * u(rng);  // through the branch
+        const Vec3 side = glm::normalize(glm::cross(d, Vec3(u(rng), u(rng), u(rng))));
+        const double off = (k % 3) * 5.0 * kPi / 180.0;
+        const Vec3 L = k % 4 == 3 ? glm::normalize(Vec3(u(rng), u(rng), u(rng)))
+                                  : std::cos(off) * -d + std::sin(off) * side;
+        const Vec3 o = through - 40.0 * d;
+        double tIn, tOut;
+        if (!layeredInterval(b, o, d, tIn, tOut)) continue;
+        int m = 0;
+        for (const auto& [name, c] :
+             {std::pair{"fibre", true}, std::pair{"fibre", false}, std::pair{"paper", false}}) {
+            const LayerModel& model = layerModel(name, c);
+            hits.clear();
+            model.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
+                hits.push_back(hit);
+                return true;
+            });
+            points.clear();
+            for (std::size_t h = 0; h < hits.size(); ++h) {
+                // Near the layer, of its own cone; every fifth a neighbour's.
+                const long cone = hits[h].cone + (h % 5 == 4 ? 1 : 0);
+                points.push_back({hits[h].t + 0.05 * u(rng), cone});
+            }
+            if (!hits.empty()) points.push_back({tOut + 0.02, hits.back().cone});  // beyond it
+            model.transmittancesAt(b, o, d, tIn, tOut, hits, points, L, at);
+            ASSERT_EQ(at.size(), points.size());
+            for (std::size_t n = 0; n < points.size(); ++n) {
+                const double expected =
+                    model.transmittance(b, o + points[n].t * d, L, points[n].cone, -d);
+                EXPECT_NEAR(at[n], expected, 5e-2) << name << " line " << k << " needle " << n;
+                worst[m] = std::max(worst[m], std::abs(at[n] - expected));
+                if (m == 0) ++needles;
+                // Beyond the bough, or in another cone's band than its own.
+                const bool mustWalk =
+                    n + 1 == points.size() ||
+                    std::floor(ConeLine(b, o, d).g(points[n].t) / b.geometry.coneSpacing_cm +
+                               0.5) != double(points[n].cone);
+                if (m == 0 && mustWalk) {
+                    ++walkedBack;
+                    EXPECT_EQ(at[n], expected) << "line " << k << " needle " << n;
+                }
+            }
+            ++m;
+        }
+    }
+    std::printf(
+        "%d needles (%d walked back): worst difference fibre correlated %.2e, "
+        "independent %.2e, paper %.2e\n",
+        needles, walkedBack, worst[0], worst[1], worst[2]);
+    EXPECT_GT(needles, 1000);
+    EXPECT_GT(walkedBack, 200);
+    EXPECT_EQ(worst[1], 0.0);
+    EXPECT_EQ(worst[2], 0.0);
+}
+
 // g along a line is concave: it rises to ConeLine::turn and falls after, and ConeLine::level
 // finds where it takes a value on either side.
 TEST(ConeBands, GRisesToItsTurnAndFallsAfter)

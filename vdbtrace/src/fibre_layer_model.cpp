@@ -113,7 +113,7 @@ public:
             arcsAlong(b, x, towardsLight, ownCone, period, light);
             if (light.empty()) return 1.0;
             arcsAlong(b, x, towardsViewer, ownCone, period, view);
-            return conditioned(light, view, period);
+            return conditioned(light, view.data(), view.size(), period);
         }
         double transmittance = 1.0;
         forEachBandFrom(b, x, towardsLight, ownCone, [&](const ConeBand& band) {
@@ -139,8 +139,76 @@ public:
             const LayerHit& hit = hits[k];
             const Vec3 x = o + hit.t * d;
             arcsAlong(b, x, towardsLight, hit.cone, period, light);
-            out[k] = light.empty() ? 1.0 : conditioned(light, view, period);
+            out[k] = light.empty() ? 1.0 : conditioned(light, view.data(), view.size(), period);
             if (hit.opacity > 0.0) view.push_back(azimuths.arc(hit.cone, x, hit.opacity, period));
+        }
+    }
+
+    // A needle's band is found by its index and g's monotone piece (cone_crossings.h); the
+    // walk back from the needle would first meet what is left of that band before it, and
+    // leave it out as the needle's own if it is its cone's and the needle lies inside the
+    // bough. Where it would not (a needle's passage past its cone's sheet, beyond the bough,
+    // or with the rest of its band hidden in the bark) the needle walks back.
+    void transmittancesAt(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn,
+                          double tOut, const std::vector<LayerHit>& hits,
+                          const std::vector<NeedleOnLine>& needles, const Vec3& towardsLight,
+                          std::vector<double>& out) const override
+    {
+        if (!mCorrelated) {
+            return LayerModel::transmittancesAt(b, o, d, tIn, tOut, hits, needles, towardsLight,
+                                                out);
+        }
+        thread_local std::vector<Arc> light, view;
+        thread_local std::vector<std::size_t> arcsBefore;  // per hit: the view's arcs before it
+        const double period = needlePeriod(b), dh = b.geometry.coneSpacing_cm;
+        const Azimuths azimuths(b);
+        const ConeLine line(b, o, d);
+        const double turn = line.turn();
+        double barkIn = 0.0, barkOut = 0.0;  // as forEachConeBand hides it
+        if (b.barkRadius_cm > 0.0 && !intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.tip_cm,
+                                                        b.barkRadius_cm, barkIn, barkOut)) {
+            barkIn = barkOut = 0.0;
+        }
+        view.clear();
+        arcsBefore.resize(hits.size());
+        for (std::size_t k = 0; k < hits.size(); ++k) {
+            arcsBefore[k] = view.size();
+            if (hits[k].opacity > 0.0) {
+                view.push_back(
+                    azimuths.arc(hits[k].cone, o + hits[k].t * d, hits[k].opacity, period));
+            }
+        }
+        // Where needle t's band begins along the line: the edge below it on the rising piece,
+        // above it on the falling one, or the piece's start.
+        const auto bandStart = [&](double t, long band) {
+            const bool rising = t < turn;
+            const double from = rising ? tIn : std::max(tIn, turn);
+            const double edge = (double(band) + (rising ? -0.5 : 0.5)) * dh;
+            const bool beyond = rising ? line.g(from) < edge : line.g(from) > edge;
+            return beyond ? line.level(edge, from, t) : from;
+        };
+        out.resize(needles.size());
+        for (std::size_t n = 0; n < needles.size(); ++n) {
+            const NeedleOnLine& needle = needles[n];
+            const Vec3 x = o + needle.t * d;
+            const long band = long(std::floor(line.g(needle.t) / dh + 0.5));
+            std::size_t own = hits.size();
+            if (band == needle.cone && needle.t > tIn && needle.t < tOut) {
+                const bool rising = needle.t < turn;
+                for (std::size_t k = 0; k < hits.size(); ++k) {
+                    if (hits[k].cone == band && (hits[k].t < turn) == rising) own = k;
+                }
+            }
+            if (own < hits.size() && barkOut > barkIn) {
+                const double start = bandStart(needle.t, band);
+                if (!(start < barkIn || needle.t > barkOut)) own = hits.size();  // all in bark
+            }
+            if (own == hits.size()) {
+                out[n] = transmittance(b, x, towardsLight, needle.cone, -d);
+                continue;
+            }
+            arcsAlong(b, x, towardsLight, needle.cone, period, light);
+            out[n] = light.empty() ? 1.0 : conditioned(light, view.data(), arcsBefore[own], period);
         }
     }
 
@@ -193,8 +261,9 @@ private:
     }
 
     // The light's transmittance along its arcs `light` (reordered), conditioned cone by cone
-    // on the view's line, whose arcs `view` missed every needle.
-    static double conditioned(std::vector<Arc>& light, const std::vector<Arc>& view, double period)
+    // on the view's line, whose `views` arcs from `view` missed every needle.
+    static double conditioned(std::vector<Arc>& light, const Arc* view, std::size_t views,
+                              double period)
     {
         thread_local std::vector<Arc> cone;
         thread_local std::vector<std::pair<double, double>> pieces;
@@ -206,8 +275,8 @@ private:
             std::size_t end = i;
             while (end < light.size() && light[end].cone == c) ++end;
             cone.clear();
-            for (const Arc& a : view) {
-                if (a.cone == c) cone.push_back(a);
+            for (std::size_t v = 0; v < views; ++v) {
+                if (view[v].cone == c) cone.push_back(view[v]);
             }
             const double seen = unionLength(pieces, cone, period);
             cone.insert(cone.end(), light.begin() + long(i), light.begin() + long(end));

@@ -45,6 +45,17 @@ void LayerModel::transmittancesAlong(const TracedBough& b, const Vec3& o, const 
     }
 }
 
+void LayerModel::transmittancesAt(const TracedBough& b, const Vec3& o, const Vec3& d, double,
+                                  double, const std::vector<LayerHit>&,
+                                  const std::vector<NeedleOnLine>& needles,
+                                  const Vec3& towardsLight, std::vector<double>& out) const
+{
+    out.resize(needles.size());
+    for (std::size_t k = 0; k < needles.size(); ++k) {
+        out[k] = transmittance(b, o + needles[k].t * d, towardsLight, needles[k].cone, -d);
+    }
+}
+
 const LayerModel& layerModel(const std::string& name, bool correlated)
 {
     return registry(correlated).get(name);

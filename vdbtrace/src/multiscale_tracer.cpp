@@ -103,7 +103,8 @@ private:
     NearestFirstQueue mQueue;  ///< the primitives the ray may yet meet
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
-    std::vector<double> mLayerLit;                    ///< their self-shadowing from one light
+    std::vector<double> mLayerLit;  ///< their (or level 1's needles') self-shadowing, one light
+    std::vector<LayerModel::NeedleOnLine> mNeedlesOnRay;  ///< level 1's, for the layer model
     std::vector<NeedleHit> mNeedleHits;               ///< a bough's needles on this ray
     std::vector<std::size_t> mByDepth;                ///< their indices, front to back
     std::vector<double> mSelf;       ///< their self-shadowing, hit-major, one per light
@@ -203,13 +204,20 @@ void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
             }
         }
     } else if (mPlan.selfShadowing) {
-        for (std::size_t h = 0; h < hits; ++h) {
-            const Vec3 x = ray.origin + mNeedleHits[h].t * ray.direction;
-            for (std::size_t i = 0; i < lights; ++i) {
+        // Level 1's needles, each seen through the layers the ray met before its band.
+        mLayerHits.clear();
+        mScene.layers->layers(b, ray.origin, ray.direction, tIn, tOut, [&](const LayerHit& hit) {
+            mLayerHits.push_back(hit);
+            return true;
+        });
+        mNeedlesOnRay.clear();
+        for (const NeedleHit& n : mNeedleHits) mNeedlesOnRay.push_back({n.t, n.cone});
+        for (std::size_t i = 0; i < lights; ++i) {
+            mScene.layers->transmittancesAt(b, ray.origin, ray.direction, tIn, tOut, mLayerHits,
+                                            mNeedlesOnRay, mLight[i].towards, mLayerLit);
+            for (std::size_t h = 0; h < hits; ++h) {
                 ++mStats.selfShadowEvaluations;
-                mSelf[h * lights + i] =
-                    mScene.layers->transmittance(b, x, mLight[i].towards, mNeedleHits[h].cone,
-                                                 -ray.direction);
+                mSelf[h * lights + i] = mLayerLit[h];
             }
         }
     }

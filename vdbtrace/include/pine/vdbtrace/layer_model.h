@@ -47,10 +47,26 @@ public:
     /// magnifies near the hot spot (a light within a degree of the view: a needle's light up
     /// to 2e-2 lower, the line's mean 1e-5); and where the line starts inside b (a viewer
     /// among the needles) only the layers in front of the viewer count, where a walk back
-    /// from the needle went on behind the viewer.
+    /// from the needle went on behind the viewer (docs/architecture.md).
     virtual void transmittancesAlong(const TracedBough& b, const Vec3& o, const Vec3& d,
                                      const std::vector<LayerHit>& hits, const Vec3& towardsLight,
                                      std::vector<double>& out) const;
+    /// A needle on a viewing line: where along it, and its cone.
+    struct NeedleOnLine {
+        double t;
+        long cone;
+    };
+    /// transmittancesAlong() for needles anywhere on the line o + t d, t in [tIn, tOut] (level
+    /// 1's, each found near its cone's sheet), `hits` the line's layers over that span:
+    /// out[k] for needles[k]. This base calls transmittance() for each; a model that
+    /// conditions on the view's line reads the layers before a needle's band from `hits`
+    /// where a walk back from the needle would leave that band out as its own (the needle
+    /// inside the span, in a band of its own cone not hidden in the bark between it and the
+    /// band's start), and walks back from the others.
+    virtual void transmittancesAt(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn,
+                                  double tOut, const std::vector<LayerHit>& hits,
+                                  const std::vector<NeedleOnLine>& needles,
+                                  const Vec3& towardsLight, std::vector<double>& out) const;
 };
 
 /// The model registered as `name`, its crossings of one cone `correlated` or not (see
