@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -230,6 +231,33 @@ TEST(ConeBands, TheClosedFormWalksTheBandsAFineMarchFinds)
     EXPECT_GT(compared, 2500);
 }
 
+// The layer models the correlation tests compare, the correlated fibre model first.
+constexpr std::pair<const char*, bool> kLayerModels[3] = {
+    {"fibre", true}, {"fibre", false}, {"paper", false}};
+
+// The layers `model` meets along o + t d over [tIn, tOut], in order.
+std::vector<LayerHit> layersAlong(const LayerModel& model, const TracedBough& b, const Vec3& o,
+                                  const Vec3& d, double tIn, double tOut)
+{
+    std::vector<LayerHit> hits;
+    model.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
+        hits.push_back(hit);
+        return true;
+    });
+    return hits;
+}
+
+// Towards a light `degrees` off the view of a line along d (towards a random side), or, if
+// `random`, anywhere.
+Vec3 lightOffView(const Vec3& d, double degrees, bool random, std::mt19937& rng)
+{
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const Vec3 side = glm::normalize(glm::cross(d, Vec3(u(rng), u(rng), u(rng))));
+    if (random) return glm::normalize(Vec3(u(rng), u(rng), u(rng)));
+    const double off = degrees * kPi / 180.0;
+    return std::cos(off) * -d + std::sin(off) * side;
+}
+
 // LayerModel::transmittancesAlong reads the view's side of the layer correlation from the
 // line's own layers, where transmittance() walks the view's line back from each needle: the
 // same bands, each integrated from its other edge. Over random lines through a paper bough
@@ -253,24 +281,16 @@ TEST(LayerCorrelation, ALinesOwnLayersConditionEachNeedleAsAWalkFromItDoes)
     for (int k = 0; k < 400; ++k) {
         const Vec3 d = glm::normalize(Vec3(u(rng), u(rng), u(rng)));
         const Vec3 at(5.0 + 6.0 * u(rng), R * u(rng), R * u(rng));
-        const Vec3 side = glm::normalize(glm::cross(d, Vec3(u(rng), u(rng), u(rng))));
         constexpr double kOffView[4] = {0.0, 1.0, 3.0, 10.0};  // degrees
-        const double off = kOffView[k % 4] * kPi / 180.0;
-        const Vec3 L = k % 5 == 4 ? glm::normalize(Vec3(u(rng), u(rng), u(rng)))
-                                  : std::cos(off) * -d + std::sin(off) * side;
+        const Vec3 L = lightOffView(d, kOffView[k % 4], k % 5 == 4, rng);
         const Vec3 o = at - 40.0 * d;
         double tIn, tOut;
         if (!layeredInterval(b, o, d, tIn, tOut)) continue;
         ++lines;
         int m = 0;
-        for (const auto& [name, c] :
-             {std::pair{"fibre", true}, std::pair{"fibre", false}, std::pair{"paper", false}}) {
+        for (const auto& [name, c] : kLayerModels) {
             const LayerModel& model = layerModel(name, c);
-            hits.clear();
-            model.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
-                hits.push_back(hit);
-                return true;
-            });
+            hits = layersAlong(model, b, o, d, tIn, tOut);
             model.transmittancesAlong(b, o, d, hits, L, along);
             ASSERT_EQ(along.size(), hits.size());
             double T = 1.0, sumAlong = 0.0, sumWalked = 0.0, sumAlone = 0.0, shown = 0.0;
@@ -332,22 +352,14 @@ TEST(LayerCorrelation, NeedlesAnywhereOnALineReadTheLayersBeforeTheirBand)
         const Vec3 d = glm::normalize(Vec3(u(rng), u(rng), u(rng)));
         Vec3 through(5.0 + 6.0 * u(rng), R * u(rng), R * u(rng));
         if (k % 4 == 1) through.y = through.z = 0.1 * u(rng);  // through the branch
-        const Vec3 side = glm::normalize(glm::cross(d, Vec3(u(rng), u(rng), u(rng))));
-        const double off = (k % 3) * 5.0 * kPi / 180.0;
-        const Vec3 L = k % 4 == 3 ? glm::normalize(Vec3(u(rng), u(rng), u(rng)))
-                                  : std::cos(off) * -d + std::sin(off) * side;
+        const Vec3 L = lightOffView(d, (k % 3) * 5.0, k % 4 == 3, rng);
         const Vec3 o = through - 40.0 * d;
         double tIn, tOut;
         if (!layeredInterval(b, o, d, tIn, tOut)) continue;
         int m = 0;
-        for (const auto& [name, c] :
-             {std::pair{"fibre", true}, std::pair{"fibre", false}, std::pair{"paper", false}}) {
+        for (const auto& [name, c] : kLayerModels) {
             const LayerModel& model = layerModel(name, c);
-            hits.clear();
-            model.layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
-                hits.push_back(hit);
-                return true;
-            });
+            hits = layersAlong(model, b, o, d, tIn, tOut);
             points.clear();
             for (std::size_t h = 0; h < hits.size(); ++h) {
                 // Near the layer, of its own cone; every fifth a neighbour's.
