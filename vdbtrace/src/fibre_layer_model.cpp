@@ -130,17 +130,14 @@ public:
                              std::vector<double>& out) const override
     {
         if (!mCorrelated) return LayerModel::transmittancesAlong(b, o, d, hits, towardsLight, out);
-        thread_local std::vector<Arc> light, view;
+        thread_local std::vector<Arc> view;
+        thread_local std::vector<std::size_t> arcsBefore;
         const double period = needlePeriod(b);
-        const Azimuths azimuths(b);
+        viewArcs(b, o, d, hits, period, view, arcsBefore);
         out.resize(hits.size());
-        view.clear();
         for (std::size_t k = 0; k < hits.size(); ++k) {
-            const LayerHit& hit = hits[k];
-            const Vec3 x = o + hit.t * d;
-            arcsAlong(b, x, towardsLight, hit.cone, period, light);
-            out[k] = light.empty() ? 1.0 : conditioned(light, view.data(), view.size(), period);
-            if (hit.opacity > 0.0) view.push_back(azimuths.arc(hit.cone, x, hit.opacity, period));
+            out[k] = seenThrough(b, o + hits[k].t * d, towardsLight, hits[k].cone, view.data(),
+                                 arcsBefore[k], period);
         }
     }
 
@@ -158,25 +155,16 @@ public:
             return LayerModel::transmittancesAt(b, o, d, tIn, tOut, hits, needles, towardsLight,
                                                 out);
         }
-        thread_local std::vector<Arc> light, view;
-        thread_local std::vector<std::size_t> arcsBefore;  // per hit: the view's arcs before it
+        thread_local std::vector<Arc> view;
+        thread_local std::vector<std::size_t> arcsBefore;
         const double period = needlePeriod(b), dh = b.geometry.coneSpacing_cm;
-        const Azimuths azimuths(b);
+        viewArcs(b, o, d, hits, period, view, arcsBefore);
         const ConeLine line(b, o, d);
         const double turn = line.turn();
         double barkIn = 0.0, barkOut = 0.0;  // as forEachConeBand hides it
         if (b.barkRadius_cm > 0.0 && !intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.tip_cm,
                                                         b.barkRadius_cm, barkIn, barkOut)) {
             barkIn = barkOut = 0.0;
-        }
-        view.clear();
-        arcsBefore.resize(hits.size());
-        for (std::size_t k = 0; k < hits.size(); ++k) {
-            arcsBefore[k] = view.size();
-            if (hits[k].opacity > 0.0) {
-                view.push_back(
-                    azimuths.arc(hits[k].cone, o + hits[k].t * d, hits[k].opacity, period));
-            }
         }
         // Where needle t's band begins along the line: the edge below it on the rising piece,
         // above it on the falling one, or the piece's start.
@@ -207,12 +195,40 @@ public:
                 out[n] = transmittance(b, x, towardsLight, needle.cone, -d);
                 continue;
             }
-            arcsAlong(b, x, towardsLight, needle.cone, period, light);
-            out[n] = light.empty() ? 1.0 : conditioned(light, view.data(), arcsBefore[own], period);
+            out[n] =
+                seenThrough(b, x, towardsLight, needle.cone, view.data(), arcsBefore[own], period);
         }
     }
 
 private:
+    // The view's arcs of a line's layers `hits`, each once, in order; arcsBefore[k] of them
+    // lie before hits[k].
+    static void viewArcs(const TracedBough& b, const Vec3& o, const Vec3& d,
+                         const std::vector<LayerHit>& hits, double period, std::vector<Arc>& view,
+                         std::vector<std::size_t>& arcsBefore)
+    {
+        const Azimuths azimuths(b);
+        view.clear();
+        arcsBefore.resize(hits.size());
+        for (std::size_t k = 0; k < hits.size(); ++k) {
+            arcsBefore[k] = view.size();
+            if (hits[k].opacity > 0.0) {
+                view.push_back(
+                    azimuths.arc(hits[k].cone, o + hits[k].t * d, hits[k].opacity, period));
+            }
+        }
+    }
+
+    // The light from `towardsLight` reaching x on a needle of cone `ownCone`, seen through the
+    // view's `views` arcs from `view`.
+    static double seenThrough(const TracedBough& b, const Vec3& x, const Vec3& towardsLight,
+                              long ownCone, const Arc* view, std::size_t views, double period)
+    {
+        thread_local std::vector<Arc> light;
+        arcsAlong(b, x, towardsLight, ownCone, period, light);
+        return light.empty() ? 1.0 : conditioned(light, view, views, period);
+    }
+
     // The period of a cone's needles in azimuth (radians).
     static double needlePeriod(const TracedBough& b)
     {
