@@ -92,6 +92,35 @@ void forEachBandFrom(const TracedBough& b, const Vec3& x, const Vec3& d, long ow
     });
 }
 
+// Azimuths about b's axis, in one frame for every line through b: made once for all the lines
+// a call walks (its frame is most of what making it costs).
+class Azimuths {
+public:
+    explicit Azimuths(const TracedBough& b)
+        : mBough(b),
+          mCotPhi(apertureTrig(b.geometry.cone.aperture_rad).oneOverTan),
+          mE1(analytic::anyPerpendicular(b.axis)),
+          mE2(glm::cross(b.axis, mE1))
+    {
+    }
+    const TracedBough& bough() const { return mBough; }
+    // The arc of cone `cone`'s needles a line meets about x, stopped there with
+    // probability `opacity` (min(1, n) of its band).
+    Arc arc(long cone, const Vec3& x, double opacity, double period) const
+    {
+        Vec3 radial;
+        coneHeight(mBough, mCotPhi, x, nullptr, &radial);
+        const double azimuth = std::atan2(glm::dot(radial, mE2), glm::dot(radial, mE1));
+        const double width = opacity * period;
+        return {cone, azimuth - 0.5 * width, width};
+    }
+
+private:
+    const TracedBough& mBough;
+    double mCotPhi;
+    Vec3 mE1, mE2;
+};
+
 class FibreLayerModel final : public LayerModel {
 public:
     explicit FibreLayerModel(bool correlated) : mCorrelated(correlated) {}
@@ -110,9 +139,10 @@ public:
         if (mCorrelated && glm::dot(towardsViewer, towardsViewer) > 0.0) {
             thread_local std::vector<Arc> light, view;
             const double period = needlePeriod(b);
-            arcsAlong(b, x, towardsLight, ownCone, period, light);
+            const Azimuths azimuths(b);
+            arcsAlong(azimuths, x, towardsLight, ownCone, period, light);
             if (light.empty()) return 1.0;
-            arcsAlong(b, x, towardsViewer, ownCone, period, view);
+            arcsAlong(azimuths, x, towardsViewer, ownCone, period, view);
             return conditioned(light, view.data(), view.size(), period);
         }
         double transmittance = 1.0;
@@ -133,11 +163,12 @@ public:
         thread_local std::vector<Arc> view;
         thread_local std::vector<std::size_t> arcsBefore;
         const double period = needlePeriod(b);
-        viewArcs(b, o, d, hits, period, view, arcsBefore);
+        const Azimuths azimuths(b);
+        viewArcs(azimuths, o, d, hits, period, view, arcsBefore);
         out.resize(hits.size());
         for (std::size_t k = 0; k < hits.size(); ++k) {
-            out[k] = seenThrough(b, o + hits[k].t * d, towardsLight, hits[k].cone, view.data(),
-                                 arcsBefore[k], period);
+            out[k] = seenThrough(azimuths, o + hits[k].t * d, towardsLight, hits[k].cone,
+                                 view.data(), arcsBefore[k], period);
         }
     }
 
@@ -158,7 +189,8 @@ public:
         thread_local std::vector<Arc> view;
         thread_local std::vector<std::size_t> arcsBefore;
         const double period = needlePeriod(b), dh = b.geometry.coneSpacing_cm;
-        viewArcs(b, o, d, hits, period, view, arcsBefore);
+        const Azimuths azimuths(b);
+        viewArcs(azimuths, o, d, hits, period, view, arcsBefore);
         const ConeLine line(b, o, d);
         const double turn = line.turn();
         double barkIn = 0.0, barkOut = 0.0;  // as forEachConeBand hides it
@@ -195,19 +227,18 @@ public:
                 out[n] = transmittance(b, x, towardsLight, needle.cone, -d);
                 continue;
             }
-            out[n] =
-                seenThrough(b, x, towardsLight, needle.cone, view.data(), arcsBefore[own], period);
+            out[n] = seenThrough(azimuths, x, towardsLight, needle.cone, view.data(),
+                                 arcsBefore[own], period);
         }
     }
 
 private:
     // The view's arcs of a line's layers `hits`, each once, in order; arcsBefore[k] of them
     // lie before hits[k].
-    static void viewArcs(const TracedBough& b, const Vec3& o, const Vec3& d,
+    static void viewArcs(const Azimuths& azimuths, const Vec3& o, const Vec3& d,
                          const std::vector<LayerHit>& hits, double period, std::vector<Arc>& view,
                          std::vector<std::size_t>& arcsBefore)
     {
-        const Azimuths azimuths(b);
         view.clear();
         arcsBefore.resize(hits.size());
         for (std::size_t k = 0; k < hits.size(); ++k) {
@@ -221,11 +252,11 @@ private:
 
     // The light from `towardsLight` reaching x on a needle of cone `ownCone`, seen through the
     // view's `views` arcs from `view`.
-    static double seenThrough(const TracedBough& b, const Vec3& x, const Vec3& towardsLight,
+    static double seenThrough(const Azimuths& azimuths, const Vec3& x, const Vec3& towardsLight,
                               long ownCone, const Arc* view, std::size_t views, double period)
     {
         thread_local std::vector<Arc> light;
-        arcsAlong(b, x, towardsLight, ownCone, period, light);
+        arcsAlong(azimuths, x, towardsLight, ownCone, period, light);
         return light.empty() ? 1.0 : conditioned(light, view, views, period);
     }
 
@@ -235,40 +266,12 @@ private:
         return 2.0 * analytic::kPi / std::max(1.0, std::round(b.geometry.cone.needlesPerCone));
     }
 
-    // Azimuths about b's axis, in one frame for every line through b.
-    class Azimuths {
-    public:
-        explicit Azimuths(const TracedBough& b)
-            : mBough(b),
-              mCotPhi(apertureTrig(b.geometry.cone.aperture_rad).oneOverTan),
-              mE1(analytic::anyPerpendicular(b.axis)),
-              mE2(glm::cross(b.axis, mE1))
-        {
-        }
-        /// The arc of cone `cone`'s needles a line meets about x, stopped there with
-        /// probability `opacity` (min(1, n) of its band).
-        Arc arc(long cone, const Vec3& x, double opacity, double period) const
-        {
-            Vec3 radial;
-            coneHeight(mBough, mCotPhi, x, nullptr, &radial);
-            const double azimuth = std::atan2(glm::dot(radial, mE2), glm::dot(radial, mE1));
-            const double width = opacity * period;
-            return {cone, azimuth - 0.5 * width, width};
-        }
-
-    private:
-        const TracedBough& mBough;
-        double mCotPhi;
-        Vec3 mE1, mE2;
-    };
-
     // The arcs of the line from x along d (forEachBandFrom's bands).
-    static void arcsAlong(const TracedBough& b, const Vec3& x, const Vec3& d, long ownCone,
+    static void arcsAlong(const Azimuths& azimuths, const Vec3& x, const Vec3& d, long ownCone,
                           double period, std::vector<Arc>& out)
     {
         out.clear();
-        const Azimuths azimuths(b);
-        forEachBandFrom(b, x, d, ownCone, [&](const ConeBand& band) {
+        forEachBandFrom(azimuths.bough(), x, d, ownCone, [&](const ConeBand& band) {
             if (!(band.needles > 0.0)) return true;
             out.push_back(
                 azimuths.arc(band.cone, x + band.t * d, std::min(1.0, band.needles), period));
