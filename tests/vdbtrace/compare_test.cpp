@@ -381,6 +381,49 @@ TEST(CompareRun, EffectsTheMethodsCannotShareAreRefused)
     EXPECT_NO_THROW(checkEffects(effects));
 }
 
+// A setting's runs are spread over the comparison: round by round, every setting once a round,
+// in the report's order, the truth once first. Back to back, each setting would be timed in
+// one stretch of a shared machine whose speed drifts, and their ratios would drift with it.
+TEST(CompareRun, EverySettingRunsOnceARoundInTheReportsOrder)
+{
+    const scenes::Scene scene = scenes::parseScene(kFirScene, "fir.json");
+    CompareSettings st;
+    st.truthSamples = 4;
+    st.truthCheckFactor = 0;
+    st.repeat = 3;
+    st.budget = false;
+    st.geometrySamples = {1, 2};
+    st.voxelSizes_cm = {};
+    st.levels = {2, 0};
+    std::vector<std::string> runs, rows;
+    const CompareRun run = runComparison(scene, st, [&](const std::string& line) {
+        if (line.find(" CPU-s") == std::string::npos) return;  // the scene's build, say
+        (line.rfind("run ", 0) == 0 ? runs : rows).push_back(line.substr(0, line.find(':')));
+    });
+    const std::vector<std::string> settings = {"geometry 1spp", "geometry 2spp", "multiscale L2",
+                                               "multiscale auto"};
+    std::vector<std::string> expected;
+    for (int round = 1; round <= 3; ++round) {
+        for (const std::string& setting : settings) {
+            expected.push_back("run " + std::to_string(round) + "/3 " + setting);
+        }
+    }
+    EXPECT_EQ(runs, expected);
+    // Each row once, after every run, with the median of its three.
+    std::vector<std::string> expectedRows = {"truth 4spp"};
+    expectedRows.insert(expectedRows.end(), settings.begin(), settings.end());
+    EXPECT_EQ(rows, expectedRows);
+    ASSERT_EQ(run.rows.size(), expectedRows.size());
+    EXPECT_EQ(run.rows.front().runs, 1);
+    for (std::size_t i = 1; i < run.rows.size(); ++i) {
+        const CompareRow& r = run.rows[i];
+        EXPECT_EQ(r.runs, 3) << r.stem();
+        EXPECT_LE(r.secondsMin, r.seconds) << r.stem();
+        EXPECT_LE(r.seconds, r.secondsMax) << r.stem();
+        EXPECT_EQ(r.image.width, 48) << r.stem();  // the first run's image, kept
+    }
+}
+
 TEST(CompareRun, UnwritableFolderFailsBeforeWork)
 {
     CompareOptions options;

@@ -490,7 +490,8 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
     s << " cm, " << st.subpixels * st.subpixels << " rays per pixel; multiscale: levels forced "
       << "to 1, 2, 3 and automatic\n";
     s << "- times: process CPU seconds (all threads) of each render, the median of " << st.repeat
-      << " run(s) by CPU seconds [the least, the most] (the truth one run), what the method "
+      << " run(s) by CPU seconds [the least, the most], the runs made round by round (each "
+         "setting once a round; the truth one run, first), what the method "
          "prepares first "
          "included (prep: the geometry's Embree BVH, the reference's bake and light grids, in "
          "wall seconds); the multiscale times include the bough law's per-bough profiles, "

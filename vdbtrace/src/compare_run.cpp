@@ -6,45 +6,62 @@
 #include "pine/vdbtrace/methods.h"
 
 #include <algorithm>
+#include <deque>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 namespace pine::vdbtrace {
 namespace {
 
-// Renders `repeat` times, each run from the scene `sceneFor(run)` gives.
-CompareRow render(const std::function<const TracedScene&(int run)>& sceneFor,
-                  const std::string& method, std::string label, std::string setting,
-                  const MethodSettings& settings, int repeat)
-{
+// One setting the comparison times: the method, the scene each run renders from, and its runs
+// so far (process CPU, wall and preparation seconds).
+struct Timed {
+    std::function<const TracedScene&(int run)> sceneFor;
+    std::string method, label, setting;
+    MethodSettings settings;
     struct Run {
         double cpu, wall, prep;
     };
     std::vector<Run> runs;
+};
+
+// Renders t once more; returns the render (every run renders the same image).
+RenderResult renderOnce(Timed& t)
+{
+    const TracedScene& scene = t.sceneFor(int(t.runs.size()));
+    const double cpu = io::processCpuSeconds();
+    RenderResult r = renderMethod(t.method).render(scene, t.settings, {});
+    t.runs.push_back({io::processCpuSeconds() - cpu, r.seconds, r.prepSeconds});
+    return r;
+}
+
+// t's row with its first render's image and trees; its times come with timeRow.
+CompareRow rowOf(const Timed& t, RenderResult first)
+{
     CompareRow row;
-    for (int i = 0; i < std::max(1, repeat); ++i) {
-        const TracedScene& scene = sceneFor(i);
-        const double cpu = io::processCpuSeconds();
-        RenderResult r = renderMethod(method).render(scene, settings, {});
-        runs.push_back({io::processCpuSeconds() - cpu, r.seconds, r.prepSeconds});
-        if (i == 0) {  // every run renders the same image
-            row.image = std::move(r.image);
-            row.treeFoliage = std::move(r.treeFoliage);
-        }
-    }
-    std::sort(runs.begin(), runs.end(), [](const Run& a, const Run& b) { return a.cpu < b.cpu; });
-    const Run& median = runs[runs.size() / 2];
-    row.method = std::move(label);
-    row.renderer = method;
-    row.setting = std::move(setting);
+    row.image = std::move(first.image);
+    row.treeFoliage = std::move(first.treeFoliage);
+    row.method = t.label;
+    row.renderer = t.method;
+    row.setting = t.setting;
+    return row;
+}
+
+// The row's times from t's runs: the median run by CPU seconds, the least and the most.
+void timeRow(CompareRow& row, Timed t)
+{
+    auto& runs = t.runs;
+    std::sort(runs.begin(), runs.end(),
+              [](const Timed::Run& a, const Timed::Run& b) { return a.cpu < b.cpu; });
+    const Timed::Run& median = runs[runs.size() / 2];
     row.seconds = median.cpu;
     row.secondsMin = runs.front().cpu;
     row.secondsMax = runs.back().cpu;
     row.wallSeconds = median.wall;
     row.runs = int(runs.size());
-    if (method != "multiscale") row.prepSeconds = median.prep;
-    return row;
+    if (t.method != "multiscale") row.prepSeconds = median.prep;
 }
 
 // The load averages over 1, 5 and 15 minutes, as /proc/loadavg has them.
@@ -155,39 +172,41 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
         };
     };
 
-    const auto judge = [&](CompareRow& row) {
+    // A row's errors and its trees' biases against the truth (the first row).
+    const auto assess = [&](CompareRow& row) {
         const CompareRow& truth = run.rows.empty() ? row : run.rows.front();
         row.errors = compareImages(row.image, truth.image);
         measureTrees(row, truth);
-        if (log) {
-            std::string line =
-                row.method + " " + row.setting + ": " + formatNumber(row.seconds, 3) + " CPU-s";
-            if (row.runs > 1) {
-                line += " [" + formatNumber(row.secondsMin, 3) + ", " +
-                        formatNumber(row.secondsMax, 3) + "]";
-            }
-            if (row.prepSeconds) {
-                line += " (" + formatNumber(*row.prepSeconds, 3) + " s preparation)";
-            }
-            if (!row.truth) line += ", rmse " + formatNumber(row.errors.rmse);
-            if (!row.truth && row.trees.trees) {
-                line += ", per-tree luminance median " +
-                        formatNumber(100.0 * row.trees.luminance.median, 3) + "%";
-            }
-            log(line);
-        }
     };
-    const auto measure = [&](CompareRow row) {
-        judge(row);
-        run.rows.push_back(std::move(row));
+    const auto report = [&](const CompareRow& row) {
+        if (!log) return;
+        std::string line =
+            row.method + " " + row.setting + ": " + formatNumber(row.seconds, 3) + " CPU-s";
+        if (row.runs > 1) {
+            line += " [" + formatNumber(row.secondsMin, 3) + ", " +
+                    formatNumber(row.secondsMax, 3) + "]";
+        }
+        if (row.prepSeconds) line += " (" + formatNumber(*row.prepSeconds, 3) + " s preparation)";
+        if (!row.truth) line += ", rmse " + formatNumber(row.errors.rmse);
+        if (!row.truth && row.trees.trees) {
+            line += ", per-tree luminance median " +
+                    formatNumber(100.0 * row.trees.luminance.median, 3) + "%";
+        }
+        log(line);
     };
     MethodSettings s;
     s.geometry.samples = st.truthSamples;
     s.geometry.sampleSeed = st.truthSeed;
-    CompareRow truth =
-        render(built, "geometry", "truth", std::to_string(st.truthSamples) + "spp", s, 1);
-    truth.truth = true;
-    measure(std::move(truth));
+    {
+        Timed t{built, "geometry", "truth", std::to_string(st.truthSamples) + "spp", s, {}};
+        RenderResult first = renderOnce(t);
+        CompareRow truth = rowOf(t, std::move(first));
+        timeRow(truth, std::move(t));
+        truth.truth = true;
+        assess(truth);
+        report(truth);
+        run.rows.push_back(std::move(truth));
+    }
     if (st.truthCheckFactor > 0) {
         MethodSettings check = s;
         check.geometry.samples = st.truthSamples * st.truthCheckFactor;
@@ -201,21 +220,34 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
                 formatNumber(run.truthCheck->errors.rmse));
         }
     }
+
+    // Every timed setting, in the report's order; budget[i] the switch row i measures, if any.
+    std::vector<Timed> timed;
+    std::vector<std::optional<BudgetSwitch>> budget;
+    const auto add = [&](Timed t, std::optional<BudgetSwitch> of = std::nullopt) {
+        timed.push_back(std::move(t));
+        budget.push_back(std::move(of));
+    };
     s.geometry.sampleSeed = 0;
     for (int n : st.geometrySamples) {
         s.geometry.samples = n;
-        measure(render(built, "geometry", "geometry", std::to_string(n) + "spp", s, st.repeat));
+        add({built, "geometry", "geometry", std::to_string(n) + "spp", s, {}});
     }
     s.reference.subpixels = st.subpixels;
     for (double h : st.voxelSizes_cm) {
         s.voxelSize_cm = h;
-        measure(render(built, "reference", "reference", formatNumber(h) + "cm", s, st.repeat));
+        add({built, "reference", "reference", formatNumber(h) + "cm", s, {}});
     }
     for (int level : st.levels) {
         s.multiscale.forceLevel = level;
-        measure(render(builtAgainFrom(scene), "multiscale", "multiscale",
-                       level ? "L" + std::to_string(level) : "auto", s, st.repeat));
+        add({builtAgainFrom(scene),
+             "multiscale",
+             "multiscale",
+             level ? "L" + std::to_string(level) : "auto",
+             s,
+             {}});
     }
+    std::deque<scenes::Scene> switched;  // each budget row's scene, for all its runs
     if (st.budget) {
         // Each switch against the row rendered with the scene's own choices: multiscale
         // (auto), and the reference at the finest voxel size.
@@ -224,15 +256,45 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
         for (const BudgetSwitch& what : errorBudgetSwitches(scene.render.model)) {
             const bool reference = what.method == "reference";
             if (reference ? finest == st.voxelSizes_cm.end() : !automatic) continue;
-            scenes::Scene switched = scene;
-            switched.render.model = what.model;
+            switched.push_back(scene);
+            switched.back().render.model = what.model;
             s.multiscale.forceLevel = 0;
             if (reference) s.voxelSize_cm = *finest;
-            CompareRow row = render(builtAgainFrom(switched), what.method, "budget:" + what.method,
-                                    what.label, s, st.repeat);
-            judge(row);
-            row.image = Image();  // only its numbers are reported
-            run.budget.push_back({what, std::move(row)});
+            add({builtAgainFrom(switched.back()),
+                 what.method,
+                 "budget:" + what.method,
+                 what.label,
+                 s,
+                 {}},
+                what);
+        }
+    }
+    // Round by round, each setting once a round: the machine's speed drifts over a comparison
+    // (by a third and more on the shared 2-core machine), and runs back to back would put each
+    // setting's runs in one stretch of it; spread over all of it, their ratios hold better.
+    std::vector<CompareRow> rows(timed.size());
+    const int rounds = std::max(1, st.repeat);
+    for (int round = 0; round < rounds; ++round) {
+        for (std::size_t i = 0; i < timed.size(); ++i) {
+            RenderResult r = renderOnce(timed[i]);
+            if (log && rounds > 1) {
+                log("run " + std::to_string(round + 1) + "/" + std::to_string(rounds) + " " +
+                    timed[i].label + " " + timed[i].setting + ": " +
+                    formatNumber(timed[i].runs.back().cpu, 3) + " CPU-s");
+            }
+            if (round > 0) continue;  // every run renders the same image
+            rows[i] = rowOf(timed[i], std::move(r));
+            assess(rows[i]);
+            if (budget[i]) rows[i].image = Image();  // only its numbers are reported
+        }
+    }
+    for (std::size_t i = 0; i < timed.size(); ++i) {
+        timeRow(rows[i], std::move(timed[i]));
+        report(rows[i]);
+        if (budget[i]) {
+            run.budget.push_back({*budget[i], std::move(rows[i])});
+        } else {
+            run.rows.push_back(std::move(rows[i]));
         }
     }
     run.load += " before; " + loadAverages() + " after";

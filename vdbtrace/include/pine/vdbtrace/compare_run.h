@@ -28,7 +28,9 @@ struct CompareSettings {
     int truthCheckFactor = 4;
     /// Runs of each render (odd: an even count takes the upper of the middle two); its time is
     /// the median run's by CPU seconds, with the least and the most (a shared machine's load
-    /// moves single runs by a third). The truth and its check are rendered once.
+    /// moves single runs by a third). The runs go round by round, each setting once a round,
+    /// so that every setting is timed across the whole comparison's drift, not in one stretch
+    /// of it. The truth and its check are rendered once, first.
     int repeat = 3;
     /// Also render the error budget (error_budget.h): every alternative of every model
     /// choice alone, multiscale (auto) or the reference at the finest voxel size.
