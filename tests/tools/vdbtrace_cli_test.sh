@@ -288,6 +288,15 @@ assert ("multiscale render: CPU seconds %g [%g, %g]" % (j["multiscale"]["cpu_sec
         j["multiscale"]["cpu_seconds_min"], j["multiscale"]["cpu_seconds_max"])) in out, out
 assert "geometry 2 spp render: CPU seconds %g" % j["geometry"]["cpu_seconds"] in out, out
 PY
+# The runs go round by round, each method once a round: back to back, a drift in the machine's
+# speed would time one method in one stretch of it.
+/usr/bin/python3 - "$work/err" <<'PY' || fail "bench's rounds: $(grep 100% "$work/err")"
+import sys
+done = [l.split(": ", 1)[1].rsplit(" ", 1)[0].strip() for l in open(sys.argv[1])
+        if l.rstrip().endswith("100%")]
+rounds = [name for i in (1, 2, 3) for name in ("multiscale %d" % i, "geometry 2 spp %d" % i)]
+assert done == rounds, done
+PY
 # Its shadow columns are the ones a render of the scene makes (three firs: a sun, shadows on).
 "$vdbtrace" render "$work/small-firs.json" --method multiscale --out "$work/small-firs.exr" \
     --stats "$work/small-firs.stats.json" >/dev/null 2>"$work/err" \

@@ -769,16 +769,8 @@ struct BenchSummary {
     double cpuMin = 0.0, cpuMax = 0.0;
 };
 
-BenchSummary benchRepeated(const scenes::Scene& scene, const std::string& method,
-                           const vdbtrace::MethodSettings& settings, const std::string& label,
-                           int repeats, double lawCacheMiB)
+BenchSummary summarize(std::vector<BenchRun> runs)
 {
-    std::vector<BenchRun> runs;
-    for (int i = 0; i < repeats; ++i) {
-        runs.push_back(benchRun(scene, method, settings,
-                                repeats > 1 ? label + " " + std::to_string(i + 1) : label,
-                                lawCacheMiB));
-    }
     std::sort(runs.begin(), runs.end(),
               [](const BenchRun& a, const BenchRun& b) { return a.cpuSeconds < b.cpuSeconds; });
     BenchSummary out;
@@ -786,6 +778,30 @@ BenchSummary benchRepeated(const scenes::Scene& scene, const std::string& method
     out.cpuMax = runs.back().cpuSeconds;
     out.median = std::move(runs[runs.size() / 2]);
     return out;
+}
+
+// One method's runs of a benchmark, and how each is made.
+struct Benched {
+    std::string method, label;
+    vdbtrace::MethodSettings settings;
+    double lawCacheMiB = 0.0;
+    std::vector<BenchRun> runs;
+};
+
+// Each method `repeats` times, round by round (every method once a round), so that each is
+// timed across the whole benchmark's drift in the machine's speed, not in one stretch of it.
+// A run keeps its numbers, not its image: the benchmark reads none.
+void benchInRounds(const scenes::Scene& scene, std::vector<Benched>& methods, int repeats)
+{
+    for (int i = 0; i < repeats; ++i) {
+        for (Benched& m : methods) {
+            BenchRun run = benchRun(scene, m.method, m.settings,
+                                    repeats > 1 ? m.label + " " + std::to_string(i + 1) : m.label,
+                                    m.lawCacheMiB);
+            run.result.image = vdbtrace::Image();
+            m.runs.push_back(std::move(run));
+        }
+    }
 }
 
 int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
@@ -804,8 +820,16 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
         scene.camera.height = height;
     }
     vdbtrace::MethodSettings settings;
-    const BenchSummary ms =
-        benchRepeated(scene, "multiscale", settings, "multiscale", repeats, lawCacheMiB);
+    std::vector<Benched> methods{{"multiscale", "multiscale", settings, lawCacheMiB, {}}};
+    if (geometrySamples > 0) {
+        vdbtrace::MethodSettings g;
+        g.geometry.samples = geometrySamples;
+        g.geometry.primitive = primitive;
+        methods.push_back(
+            {"geometry", "geometry " + std::to_string(geometrySamples) + " spp", g, 0.0, {}});
+    }
+    benchInRounds(scene, methods, repeats);
+    const BenchSummary ms = summarize(std::move(methods[0].runs));
     const vdbtrace::RenderResult& r = ms.median.result;
     const auto& st = r.stats;
     const double pixels = double(st.coneRays);
@@ -858,11 +882,9 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
         std::cout << "shadow columns " << double(ms.median.columnsBytes) / kMiB << " MiB\n";
     }
     if (geometrySamples > 0) {
-        vdbtrace::MethodSettings g;
-        g.geometry.samples = geometrySamples;
-        g.geometry.primitive = primitive;
-        const std::string label = "geometry " + std::to_string(geometrySamples) + " spp";
-        const BenchSummary geo = benchRepeated(scene, "geometry", g, label, repeats, 0.0);
+        const vdbtrace::MethodSettings& g = methods[1].settings;
+        const std::string& label = methods[1].label;
+        const BenchSummary geo = summarize(std::move(methods[1].runs));
         const double ratio = ms.median.cpuSeconds / geo.median.cpuSeconds;
         std::cout << label << " render: CPU seconds " << geo.median.cpuSeconds << " ["
                   << geo.cpuMin << ", " << geo.cpuMax << "], wall seconds "
@@ -987,9 +1009,11 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
             settings.geometry.samples = geometrySamples;
             settings.geometry.primitive = primitive;
             tool::resetPeakMemory();
-            const BenchSummary b = benchRepeated(
-                scene, method, settings,
-                "step " + std::to_string(k) + " " + method, repeats, lawCacheMiB);
+            // One method at a time: each step's peak memory is its own.
+            std::vector<Benched> one{
+                {method, "step " + std::to_string(k) + " " + method, settings, lawCacheMiB, {}}};
+            benchInRounds(scene, one, repeats);
+            const BenchSummary b = summarize(std::move(one[0].runs));
             const double peak = tool::peakMemoryMiBSinceReset();
             const BenchRun& r = b.median;
             cpu[method].push_back(r.cpuSeconds);
@@ -1300,8 +1324,9 @@ int main(int argc, char** argv)
     addNeedlePrimitive(*benchCmd, benchPrimitive);
     benchCmd
         ->add_option("--repeat", benchRepeats,
-                     "Runs of each render (odd); the times are the median by CPU seconds, "
-                     "with the least and the most")
+                     "Runs of each render (odd), round by round (each method once a "
+                     "round); the times are the median by CPU seconds, with the least and the "
+                     "most")
         ->check(oddRuns())
         ->capture_default_str();
     benchCmd->add_option("--json", benchJson, "Also write every number as JSON");
@@ -1380,8 +1405,8 @@ int main(int argc, char** argv)
         ->check(CLI::Range(1, 4096));
     compareCmd
         ->add_option("--repeat", compareRepeat,
-                     "Runs of each render, timed as the median by CPU seconds (odd; default 3, "
-                     "1 with --quick)")
+                     "Runs of each render, round by round (each setting once a round), timed "
+                     "as the median by CPU seconds (odd; default 3, 1 with --quick)")
         ->check(oddRuns());
     compareCmd->add_flag("--no-budget", noBudget,
                          "Skip the error budget (each model choice's alternatives alone)");
