@@ -193,11 +193,8 @@ public:
         viewArcs(azimuths, o, d, hits, period, view, arcsBefore);
         const ConeLine line(b, o, d);
         const double turn = line.turn();
-        double barkIn = 0.0, barkOut = 0.0;  // as forEachConeBand hides it
-        if (b.barkRadius_cm > 0.0 && !intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.tip_cm,
-                                                        b.barkRadius_cm, barkIn, barkOut)) {
-            barkIn = barkOut = 0.0;
-        }
+        double barkIn, barkOut;  // as forEachConeBand hides it
+        barkInterval(b, o, d, barkIn, barkOut);
         // Where needle t's band begins along the line: the edge below it on the rising piece,
         // above it on the falling one, or the piece's start.
         const auto bandStart = [&](double t, long band) {

@@ -60,6 +60,8 @@ private:
         std::size_t layer = kNoLayer;
     };
     static constexpr std::size_t kNoLayer = std::size_t(-1);
+    // mLayerHits: bough b's layers along the ray over [tIn, tOut], as the layer model gives them.
+    void collectLayers(const ConeRay& ray, const TracedBough& b, double tIn, double tOut);
     // Shades mNeedleHits (levels 1-2): each needle's light through the bough's other layers
     // under the layer model (section 6's self-shadowing, counted, not approximated) and
     // through the scene from where the needles lie.
@@ -182,6 +184,16 @@ double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index,
                             &mShadowSamples);
 }
 
+void MultiscaleRayTracer::collectLayers(const ConeRay& ray, const TracedBough& b, double tIn,
+                                        double tOut)
+{
+    mLayerHits.clear();
+    mScene.layers->layers(b, ray.origin, ray.direction, tIn, tOut, [&](const LayerHit& hit) {
+        mLayerHits.push_back(hit);
+        return true;
+    });
+}
+
 void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
                                        const TracedBough& b, double tIn, double tOut, int level)
 {
@@ -205,11 +217,7 @@ void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
         }
     } else if (mPlan.selfShadowing) {
         // Level 1's needles, each seen through the layers the ray met before its band.
-        mLayerHits.clear();
-        mScene.layers->layers(b, ray.origin, ray.direction, tIn, tOut, [&](const LayerHit& hit) {
-            mLayerHits.push_back(hit);
-            return true;
-        });
+        collectLayers(ray, b, tIn, tOut);
         mNeedlesOnRay.clear();
         for (const NeedleHit& n : mNeedleHits) mNeedlesOnRay.push_back({n.t, n.cone});
         for (std::size_t i = 0; i < lights; ++i) {
@@ -291,12 +299,7 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
         // composited alone, each of opacity coverage alpha_i, exceed where coverage < 1 (the
         // edge of the strip). So each layer's share of the bough's coverage is what it
         // composites.
-        mLayerHits.clear();
-        mScene.layers->layers(b, ray.origin, ray.direction, tIn, tOut,
-                              [&](const LayerHit& hit) {
-                                  mLayerHits.push_back(hit);
-                                  return true;
-                              });
+        collectLayers(ray, b, tIn, tOut);
         std::stable_sort(mLayerHits.begin(), mLayerHits.end(),
                          [](const LayerHit& x, const LayerHit& y) { return x.t < y.t; });
         double covered = 0.0;  // by this bough's layers in front, of the footprint

@@ -79,6 +79,19 @@ inline bool insideBark(const TracedBough& b, const Vec3& x)
            glm::length(r - h * b.axis) < b.barkRadius_cm;
 }
 
+/// Where o + t d lies inside the bark, [barkIn, barkOut]: the branch's cylinder of radius
+/// barkRadius_cm from the base to the tip (beyond the tip the last cones' needles are not in
+/// it); an empty [0, 0] where it does not, or b has no bark.
+inline void barkInterval(const TracedBough& b, const Vec3& o, const Vec3& d, double& barkIn,
+                         double& barkOut)
+{
+    barkIn = barkOut = 0.0;
+    if (b.barkRadius_cm > 0.0 && !intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.tip_cm,
+                                                    b.barkRadius_cm, barkIn, barkOut)) {
+        barkIn = barkOut = 0.0;
+    }
+}
+
 /// Calls visit(j, t) for every crossing of cone j in [0, floor(length / dh)] by the line
 /// o + t d, t in [tIn, tOut], in order: the march moves g by at most dh / 4 a step (|dg/dt|
 /// <= 1 + cot(phi)) and places each crossing by linear interpolation within its step.
@@ -291,14 +304,8 @@ void forEachConeBand(const TracedBough& b, const Vec3& o, const Vec3& d, double 
         out[0] = sigma(t1);
         out[1] = sigma(t2);
     };
-    // Where the line lies inside the bark: the branch's cylinder of radius barkRadius_cm
-    // from the base to the tip (beyond the tip the last cones' needles are not in it).
     double barkIn = 0.0, barkOut = 0.0;
-    if (hiddenInBark && b.barkRadius_cm > 0.0 &&
-        !intersectCylinder(ConeRay{o, d, 0.0}, b.base_cm, b.tip_cm, b.barkRadius_cm, barkIn,
-                           barkOut)) {
-        barkIn = barkOut = 0.0;
-    }
+    if (hiddenInBark) barkInterval(b, o, d, barkIn, barkOut);
     // Where sigma has kinks, panels end: where the line passes the axis (the radial
     // direction turns over) and where the needles' coverage reaches 1 near it.
     double kinks[3] = {line.closest(), 0.0, 0.0};
