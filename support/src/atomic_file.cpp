@@ -132,7 +132,12 @@ std::string probeFolder(const fs::path& folder, const fs::path& beside)
     if (!fs::is_directory(folder, error)) return "folder '" + folder.string() + "' is missing";
     const fs::path probe = temporaryBeside(beside);
     std::FILE* f = std::fopen(probe.c_str(), "wx");
-    if (!f) return "folder '" + folder.string() + "' is not writable: " + std::strerror(errno);
+    // The system's own reason: a folder that exists can refuse a new file for reasons other
+    // than its permissions (a read-only mount; /proc answers ENOENT).
+    if (!f) {
+        return "cannot create a file in folder '" + folder.string() + "' (" + std::strerror(errno) +
+               ")";
+    }
     std::fclose(f);
     fs::remove(probe, error);
     return "";

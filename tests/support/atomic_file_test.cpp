@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -78,6 +80,19 @@ TEST(AtomicFile, CheckWritableFolderCreatesItOrSaysWhyNot)
     dir.write("plain.txt", "not a folder");
     EXPECT_THROW(checkWritableFolder(dir.path() / "plain.txt" / "c"), InputError);
     EXPECT_THROW(checkWritableFolder("/proc/no-such-dir"), InputError);
+}
+
+TEST(AtomicFile, AFolderThatRefusesNewFilesIsNamedWithTheSystemsReason)
+{
+    // /proc exists and takes no new file (ENOENT, whoever runs the test, root included).
+    try {
+        checkWritable("/proc/frame.exr");
+        ADD_FAILURE() << "no InputError for a file in /proc";
+    } catch (const InputError& error) {
+        EXPECT_EQ(std::string(error.what()),
+                  "cannot write '/proc/frame.exr': cannot create a file in folder '/proc' (" +
+                      std::string(std::strerror(ENOENT)) + ")");
+    }
 }
 
 TEST(AtomicFile, ANameNearTheLongestAllowedIsWrittenNotRefused)
