@@ -8,9 +8,9 @@
 #
 #   bash scripts/compare_reports.sh [NAME...]   NAME: three-firs, paper-forest (default: both)
 #
-# About 5 minutes for the three firs and 25 for the forest on 2 cores; uses build/bin (build
-# first) and matplotlib for the plots. Run it on a machine left alone: the times are CPU
-# seconds, but a loaded machine still moves them.
+# About 4 minutes for the three firs and 36 for the forest on 2 cores (2026-12-05); uses
+# build/bin (build first) and matplotlib for the plots. Run it on a machine left alone: the
+# times are CPU seconds, but a loaded machine still moves them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${VDBTRACE:-build/bin/vdbtrace}
