@@ -137,13 +137,7 @@ public:
                          long ownCone, const Vec3& towardsViewer) const override
     {
         if (mCorrelated && glm::dot(towardsViewer, towardsViewer) > 0.0) {
-            thread_local std::vector<Arc> light, view;
-            const double period = needlePeriod(b);
-            const Azimuths azimuths(b);
-            arcsAlong(azimuths, x, towardsLight, ownCone, period, light);
-            if (light.empty()) return 1.0;
-            arcsAlong(azimuths, x, towardsViewer, ownCone, period, view);
-            return conditioned(light, view.data(), view.size(), period);
+            return walkedBoth(Azimuths(b), x, towardsLight, ownCone, towardsViewer);
         }
         double transmittance = 1.0;
         forEachBandFrom(b, x, towardsLight, ownCone, [&](const ConeBand& band) {
@@ -220,8 +214,8 @@ public:
                 const double start = bandStart(needle.t, band);
                 if (!(start < barkIn || needle.t > barkOut)) own = hits.size();  // all in bark
             }
-            if (own == hits.size()) {
-                out[n] = transmittance(b, x, towardsLight, needle.cone, -d);
+            if (own == hits.size()) {  // transmittance() towards the light, seen from -d
+                out[n] = walkedBoth(azimuths, x, towardsLight, needle.cone, -d);
                 continue;
             }
             out[n] = seenThrough(azimuths, x, towardsLight, needle.cone, view.data(),
@@ -230,6 +224,19 @@ public:
     }
 
 private:
+    // The light from `towardsLight` reaching x on a needle of cone `ownCone`, seen from
+    // `towardsViewer`: both lines walked from x through the bough's layers.
+    static double walkedBoth(const Azimuths& azimuths, const Vec3& x, const Vec3& towardsLight,
+                             long ownCone, const Vec3& towardsViewer)
+    {
+        thread_local std::vector<Arc> light, view;
+        const double period = needlePeriod(azimuths.bough());
+        arcsAlong(azimuths, x, towardsLight, ownCone, period, light);
+        if (light.empty()) return 1.0;
+        arcsAlong(azimuths, x, towardsViewer, ownCone, period, view);
+        return conditioned(light, view.data(), view.size(), period);
+    }
+
     // The view's arcs of a line's layers `hits`, each once, in order; arcsBefore[k] of them
     // lie before hits[k].
     static void viewArcs(const Azimuths& azimuths, const Vec3& o, const Vec3& d,
