@@ -16,7 +16,8 @@ namespace pine::vdbtrace {
 namespace {
 
 // One setting the comparison times: the method, the scene each run renders from, and its runs
-// so far (process CPU, wall and preparation seconds).
+// so far (process CPU, wall and preparation seconds); for an error budget's row, the switch it
+// measures.
 struct Timed {
     std::function<const TracedScene&(int run)> sceneFor;
     std::string method, label, setting;
@@ -25,6 +26,7 @@ struct Timed {
         double cpu, wall, prep;
     };
     std::vector<Run> runs;
+    std::optional<BudgetSwitch> budget;
 };
 
 // Renders t once more; returns the render (every run renders the same image).
@@ -198,7 +200,7 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
     s.geometry.samples = st.truthSamples;
     s.geometry.sampleSeed = st.truthSeed;
     {
-        Timed t{built, "geometry", "truth", std::to_string(st.truthSamples) + "spp", s, {}};
+        Timed t{built, "geometry", "truth", std::to_string(st.truthSamples) + "spp", s, {}, {}};
         RenderResult first = renderOnce(t);
         CompareRow truth = rowOf(t, std::move(first));
         timeRow(truth, std::move(t));
@@ -221,31 +223,27 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
         }
     }
 
-    // Every timed setting, in the report's order; budget[i] the switch row i measures, if any.
+    // Every timed setting, in the report's order.
     std::vector<Timed> timed;
-    std::vector<std::optional<BudgetSwitch>> budget;
-    const auto add = [&](Timed t, std::optional<BudgetSwitch> of = std::nullopt) {
-        timed.push_back(std::move(t));
-        budget.push_back(std::move(of));
-    };
     s.geometry.sampleSeed = 0;
     for (int n : st.geometrySamples) {
         s.geometry.samples = n;
-        add({built, "geometry", "geometry", std::to_string(n) + "spp", s, {}});
+        timed.push_back({built, "geometry", "geometry", std::to_string(n) + "spp", s, {}, {}});
     }
     s.reference.subpixels = st.subpixels;
     for (double h : st.voxelSizes_cm) {
         s.voxelSize_cm = h;
-        add({built, "reference", "reference", formatNumber(h) + "cm", s, {}});
+        timed.push_back({built, "reference", "reference", formatNumber(h) + "cm", s, {}, {}});
     }
     for (int level : st.levels) {
         s.multiscale.forceLevel = level;
-        add({builtAgainFrom(scene),
-             "multiscale",
-             "multiscale",
-             level ? "L" + std::to_string(level) : "auto",
-             s,
-             {}});
+        timed.push_back({builtAgainFrom(scene),
+                         "multiscale",
+                         "multiscale",
+                         level ? "L" + std::to_string(level) : "auto",
+                         s,
+                         {},
+                         {}});
     }
     std::deque<scenes::Scene> switched;  // each budget row's scene, for all its runs
     if (st.budget) {
@@ -260,13 +258,13 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
             switched.back().render.model = what.model;
             s.multiscale.forceLevel = 0;
             if (reference) s.voxelSize_cm = *finest;
-            add({builtAgainFrom(switched.back()),
-                 what.method,
-                 "budget:" + what.method,
-                 what.label,
-                 s,
-                 {}},
-                what);
+            timed.push_back({builtAgainFrom(switched.back()),
+                             what.method,
+                             "budget:" + what.method,
+                             what.label,
+                             s,
+                             {},
+                             what});
         }
     }
     // Round by round, each setting once a round: the machine's speed drifts over a comparison
@@ -285,14 +283,15 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
             if (round > 0) continue;  // every run renders the same image
             rows[i] = rowOf(timed[i], std::move(r));
             assess(rows[i]);
-            if (budget[i]) rows[i].image = Image();  // only its numbers are reported
+            if (timed[i].budget) rows[i].image = Image();  // only its numbers are reported
         }
     }
     for (std::size_t i = 0; i < timed.size(); ++i) {
+        std::optional<BudgetSwitch> budget = std::move(timed[i].budget);
         timeRow(rows[i], std::move(timed[i]));
         report(rows[i]);
-        if (budget[i]) {
-            run.budget.push_back({*budget[i], std::move(rows[i])});
+        if (budget) {
+            run.budget.push_back({*budget, std::move(rows[i])});
         } else {
             run.rows.push_back(std::move(rows[i]));
         }
