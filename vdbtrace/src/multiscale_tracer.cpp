@@ -78,16 +78,20 @@ private:
     // footprint, a disc across the camera ray, spreads the lines across an occluder only as
     // far as it spreads across that occluder's strip (ShadowSamples::footprintNormal).
     double shadowOf(const ConeRay& ray, std::size_t index, std::size_t light, double tRef);
-    // Level 3's: the light each half of the bough reflects lies across the footprint's share
-    // of its strip as the law's profile `reflects` says (most of it along the lit edge of a
-    // self-shadowed bough), along the chord [tIn, tOut]. The share is cut into kShadowStrips
-    // strips across, each three points per half weighted by what it reflects, each reading the
-    // occluders over its own width: one line read over the whole footprint multiplies the
-    // occluders' means and samples the strip's middle, where the branch is, not the lit edge.
-    // `behind` is the opacity the rear half's light lies behind where the law's rear profile
-    // does not already hold it (RearComposite::Own: the front's), else null.
+    // Level 3's: the needles of each half of the bough that the light reaches lie across the
+    // footprint's share of its strip as the law's transfer `litShare` says (most of them along
+    // the lit edge of a self-shadowed bough), along the chord [tIn, tOut]. The share is cut
+    // into kShadowStrips strips across, each three points per half weighted by what of it is
+    // lit, each reading the occluders over its own width: one line read over the whole
+    // footprint multiplies the occluders' means and samples the strip's middle, where the
+    // branch is, not the lit edge. The weights are the lit share, not what it reflects
+    // towards the camera (the law's diffuse profile), and both halves take one mean: either
+    // alternative was measured and moves the paper forest and the two-bough tests against the
+    // needles in opposite directions (docs/models.md, "Where along the chord"). `behind` is
+    // the opacity the rear half's light lies behind where the law's rear profile does not
+    // already hold it (RearComposite::Own: the front's), else null.
     double shadowAcross(const ConeRay& ray, std::size_t index, std::size_t light,
-                        const FrontRearProfile& reflects, const StripProfile* behind, double xi,
+                        const FrontRearProfile& litShare, const StripProfile* behind, double xi,
                         double w, double tIn, double tMid, double tOut);
 
     const TracedScene& mScene;
@@ -136,8 +140,8 @@ double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std:
                             &mShadowSamples);
 }
 
-double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index,
-                                         std::size_t light, const FrontRearProfile& reflects,
+double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index, std::size_t light,
+                                         const FrontRearProfile& litShare,
                                          const StripProfile* behind, double xi, double w,
                                          double tIn, double tMid, double tOut)
 {
@@ -157,9 +161,9 @@ double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index,
     const double strip = (hi - lo) / kShadowStrips;  // cm across each
     for (int k = 0; k < kShadowStrips && strip > 0.0; ++k) {
         const double at = lo + (k + 0.5) * strip;
-        // What each half reflects over this strip (the rear as seen through the front).
-        const double front = reflects.front.overFootprint(at, R, strip) * strip;
-        double rear = reflects.rear.overFootprint(at, R, strip) * strip;
+        // What of each half is lit over this strip (the rear as seen through the front).
+        const double front = litShare.front.overFootprint(at, R, strip) * strip;
+        double rear = litShare.rear.overFootprint(at, R, strip) * strip;
         if (behind) rear *= 1.0 - behind->overFootprint(at, R, strip);
         // Along the chord, each half's needles at the centres of its thirds.
         for (int j = 0; j < 3; ++j) {
