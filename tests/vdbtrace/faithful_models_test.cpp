@@ -489,32 +489,20 @@ TEST(FaithfulModels, AFarBoughsShadowSpreadsAsItsPixelsFootprintDoes)
     }
 }
 
-// One long paper bough side-on (as LongBough at 90 degrees, seen from 400 cm), lit from
-// straight above, under an opaque rod 0.8 cm in radius running along it 6 cm above, moved
-// 1 cm away from the camera: the rod's shadow falls on the bough's rear half (y 0.2 to 1.8,
-// the needles reaching 1.6 from the axis) and spares its front. The luminance of the bough's
-// rows (z within 3 cm of its axis) with the rod, over that without it, so that what the rod
-// itself shows in the frame is left out.
+// One long paper bough side-on (LongBough at 90 degrees), lit from straight above, under an
+// opaque rod 0.8 cm in radius running along it 6 cm above, moved 1 cm away from the camera:
+// the rod's shadow falls on the bough's rear half (y 0.2 to 1.8, the needles reaching 1.6 from
+// the axis) and spares its front. The luminance of the bough's rows (z within 3 cm of its
+// axis) with the rod, over that without it, so that what the rod itself shows in the frame is
+// left out.
 double underTheRod(bool rod, int level, unsigned seed, bool needles)
 {
-    scenes::Scene scene = scenes::parseScene(R"({"name": "bough under a rod",
-  "camera": {"position": [0, -400, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 6,
-             "resolution": [160, 120]},
-  "lights": [{"type": "directional", "direction": [0, 0, 1]}],
-  "ground": {"type": "none"}, "species": {}, "trees": [],
-  "effects": ["diffuse", "shadows", "self_shadowing"]})",
-                                             "bough-under-a-rod.json");
-    TracedScene traced = buildTracedScene(scene);
-    if (rod) traced.branches.push_back(TracedBranch{Vec3(-100, 1, 6), Vec3(100, 1, 6), 0.8});
-    BoughDescription d;
-    d.spec.base_cm = Vec3(-100.0, 0.0, 0.0);
-    d.spec.tip_cm = Vec3(100.0, 0.0, 0.0);
-    d.spec.needles = analytic::paperBough();
-    d.seed = seed;
-    traced.boughs.push_back(makeTracedBough(d, scene.camera.position_cm, traced.lights,
-                                            boughLaw(scene.render.model.boughLaw), *traced.layers,
-                                            BoughLawNeeds::from(EffectsPlan::from(scene.effects))));
-    indexPrimitives(traced);
+    LongBough bough(90.0, {}, seed, R"("diffuse", "shadows", "self_shadowing")", "[0, 0, 1]");
+    TracedScene& traced = bough.traced;
+    if (rod) {
+        traced.branches.push_back(TracedBranch{Vec3(-100, 1, 6), Vec3(100, 1, 6), 0.8});
+        indexPrimitives(traced);
+    }
     RenderResult r;
     if (needles) {
         GeometryOptions g;
@@ -525,8 +513,9 @@ double underTheRod(bool rod, int level, unsigned seed, bool needles)
         m.forceLevel = level;
         r = renderMultiscale(traced, m);
     }
-    // 120 rows over 2 * 400 tan(3 degrees) = 41.9 cm: the bough's are within 3 cm of the middle.
-    const double rowsPerCm = r.image.height / (800.0 * std::tan(3.0 * kPi / 180.0));
+    // The frame's rows span 2 * 400 tan(4.5 degrees) = 63 cm: the bough's are within 3 cm of
+    // the middle.
+    const double rowsPerCm = r.image.height / (800.0 * std::tan(4.5 * kPi / 180.0));
     double sum = 0.0;
     for (int y = 0; y < r.image.height; ++y) {
         if (std::abs(y + 0.5 - 0.5 * r.image.height) > 3.0 * rowsPerCm) continue;
