@@ -85,9 +85,9 @@ private:
     // lit, each reading the occluders over its own width: one line read over the whole
     // footprint multiplies the occluders' means and samples the strip's middle, where the
     // branch is, not the lit edge. The weights are the lit share, not what it reflects
-    // towards the camera (the law's diffuse profile), and both halves take one mean: either
-    // alternative was measured and moves the paper forest and the two-bough tests against the
-    // needles in opposite directions (docs/models.md, "Where along the chord"). `behind` is
+    // towards the camera (the law's diffuse profile), and both halves take one mean: neither
+    // alternative, measured, brings both the paper forest and the two-bough tests closer to
+    // the needles (docs/models.md, "Where along the chord"). `behind` is
     // the opacity the rear half's light lies behind where the law's rear profile does not
     // already hold it (RearComposite::Own: the front's), else null.
     double shadowAcross(const ConeRay& ray, std::size_t index, std::size_t light,
