@@ -8,11 +8,12 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <new>
 #include <string>
-#include <memory>
 
 namespace pine::tool {
 namespace {
@@ -52,7 +53,7 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         if (e.get_exit_code() == 0) return app.exit(e);  // --help
-        std::cerr << name << ": " << oneLine(e.what()) << " (see --help)\n";
+        errorLine(std::string(name) + ": " + oneLine(e.what()) + " (see --help)");
         return 2;
     }
     std::unique_ptr<tbb::global_control> limit;
@@ -63,20 +64,26 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
     try {
         return body();
     } catch (const InputError& e) {
-        Progress::endOpenLine();
-        std::cerr << name << ": " << oneLine(e.what()) << '\n';
+        errorLine(std::string(name) + ": " + e.what());
         return 2;
     } catch (const std::bad_alloc&) {
-        Progress::endOpenLine();
-        std::cerr << name << ": out of memory: the scene or the settings ask for more than this "
-                             "machine has (lower the resolution, the samples, the trees or the "
-                             "voxel size)\n";
+        errorLine(std::string(name) +
+                  ": out of memory: the scene or the settings ask for more than this machine "
+                  "has (lower the resolution, the samples, the trees or the voxel size)");
         return 2;
     } catch (const std::exception& e) {
-        Progress::endOpenLine();
-        std::cerr << name << ": " << oneLine(e.what()) << '\n';
+        errorLine(std::string(name) + ": " + e.what());
         return 1;
     }
+}
+
+void errorLine(const std::string& text)
+{
+    Progress::endOpenLine();
+    const std::string line = oneLine(text) + '\n';
+    std::cerr.flush();
+    std::fwrite(line.data(), 1, line.size(), stderr);
+    std::fflush(stderr);
 }
 
 bool quiet() { return gQuiet; }

@@ -704,11 +704,11 @@ int renderOnRanks(vdbtrace::Ranks& ranks, CLI::App& app, const std::function<int
                                                       std::size_t(std::min(bound, shareOfCores)));
     }
     if (ranks.rank() != 0) tool::setQuiet(true);
-    const auto fail = [&](std::string what, int status) {
-        std::replace(what.begin(), what.end(), '\n', ' ');
-        tool::Progress::endOpenLine();
-        std::cerr << "vdbtrace: rank " << ranks.rank() << " of " << ranks.size() << ": " << what
-                  << " (ending the job)\n";
+    const auto fail = [&](const std::string& what, int status) {
+        // In one write: mpirun relays a rank's stderr as it comes and prints its MPI_ABORT
+        // banner between two pieces of a line written piece by piece.
+        tool::errorLine("vdbtrace: rank " + std::to_string(ranks.rank()) + " of " +
+                        std::to_string(ranks.size()) + ": " + what + " (ending the job)");
         ranks.abort(status);
     };
     try {

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <ostream>
+#include <string>
 
 namespace pine::tool {
 
@@ -24,6 +25,11 @@ void setQuiet(bool quiet);
 /// Where informational lines go: stderr, or nowhere under --quiet. Warnings and errors go to
 /// std::cerr whatever the flag.
 std::ostream& info();
+
+/// Ends an open progress line and writes `text` as one line on stderr in a single write, so
+/// that no other process's output (mpirun's, another rank's) lands inside it; line breaks in
+/// `text` become spaces.
+void errorLine(const std::string& text);
 
 /// A finite number > 0 (CLI::PositiveNumber lets nan and inf through and prints DBL_MAX).
 CLI::Validator positiveNumber();
