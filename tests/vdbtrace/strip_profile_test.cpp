@@ -24,7 +24,7 @@ TEST(StripProfile, AConstantIsTheStripCoverageTimesItsValue)
 TEST(StripProfile, FootprintsTilingTheStripSumToItsIntegral)
 {
     // Cells 0.1, 0.5, 0.9, 0.3 over [-R, R], R = 2: integral 2 R mean = 4 x 0.45 = 1.8.
-    const StripProfile p = StripProfile::sampled({0.1, 0.5, 0.9, 0.3});
+    const StripProfile p = StripProfile::sampled(std::vector<double>{0.1, 0.5, 0.9, 0.3});
     EXPECT_DOUBLE_EQ(p.mean(), 0.45);
     for (const double w : {0.13, 0.5, 1.7, 6.0}) {
         double sum = 0.0;

@@ -23,6 +23,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -116,13 +117,15 @@ public:
         const double cotPhi = trig.oneOverTan, sinPhi = trig.sinPhi, cosPhi = trig.cosPhi;
         const std::size_t lights = towardsLights.size();
         // Per half (0 front, 1 rear) and cell: the opacity; per light, what is lit (the
-        // transfer) and what it reflects.
-        using Cells = std::vector<double>;
-        Cells alpha[2] = {Cells(kCells, 0.0), Cells(kCells, 0.0)};
-        std::vector<Cells> lit[2], diffuse[2], specular[2];
-        for (int h = 0; h < 2; ++h) {
-            lit[h] = diffuse[h] = specular[h] = std::vector<Cells>(lights, Cells(kCells, 0.0));
-        }
+        // transfer) and what it reflects. Per thread, so that a bough's shading allocates
+        // only the profiles it returns.
+        using Cells = std::array<double, kCells>;
+        struct PerLight {
+            Cells lit[2], diffuse[2], specular[2];
+        };
+        Cells alpha[2] = {};
+        thread_local std::vector<PerLight> perLight;
+        perLight.assign(lights, PerLight{});
         // Opacities are even in the offset: with no light to shade, half the cells do.
         const auto shade = [&](const ShownLayer& shown) {
             alpha[shown.half][shown.cell] += shown.share;
@@ -134,13 +137,14 @@ public:
             for (std::size_t i = 0; i < lights; ++i) {
                 const Vec3& L = towardsLights[i];
                 const double seen = shown.share * (needs.transfer ? shown.lit[i] : 1.0);
-                lit[shown.half][i][shown.cell] += seen;
+                PerLight& light = perLight[i];
+                light.lit[shown.half][shown.cell] += seen;
                 if (needs.diffuse) {
-                    diffuse[shown.half][i][shown.cell] +=
+                    light.diffuse[shown.half][shown.cell] +=
                         seen * analytic::needleDiffuse(needle, L, V);
                 }
                 if (needs.specular) {
-                    specular[shown.half][i][shown.cell] +=
+                    light.specular[shown.half][shown.cell] +=
                         seen * analytic::needleSpecular(needle, L, V, b.exponent);
                 }
             }
@@ -157,23 +161,22 @@ public:
             if (!(total > 1.0)) continue;
             for (int h = 0; h < 2; ++h) {
                 alpha[h][k] /= total;
-                for (std::size_t i = 0; i < lights; ++i) {
-                    lit[h][i][k] /= total;
-                    diffuse[h][i][k] /= total;
-                    specular[h][i][k] /= total;
+                for (PerLight& light : perLight) {
+                    light.lit[h][k] /= total;
+                    light.diffuse[h][k] /= total;
+                    light.specular[h][k] /= total;
                 }
             }
         }
-        const auto profiles = [](const Cells& front, const Cells& rear) {
-            return FrontRearProfile{StripProfile::sampled(front), StripProfile::sampled(rear)};
+        const auto profiles = [](const Cells(&halves)[2]) {
+            return FrontRearProfile{StripProfile::sampled(halves[0]),
+                                    StripProfile::sampled(halves[1])};
         };
-        out.alpha = profiles(alpha[0], alpha[1]);
-        for (std::size_t i = 0; i < lights; ++i) {
-            BoughLightTransfer light;
-            light.transfer = profiles(lit[0][i], lit[1][i]);
-            light.diffuse = profiles(diffuse[0][i], diffuse[1][i]);
-            light.specular = profiles(specular[0][i], specular[1][i]);
-            out.lights.push_back(light);
+        out.alpha = profiles(alpha);
+        out.lights.reserve(lights);
+        for (const PerLight& light : perLight) {
+            out.lights.push_back(
+                {profiles(light.lit), profiles(light.diffuse), profiles(light.specular)});
         }
         return out;
     }

@@ -13,7 +13,7 @@ StripProfile StripProfile::constant(double value)
     return p;
 }
 
-StripProfile StripProfile::sampled(const std::vector<double>& cells)
+StripProfile StripProfile::sampled(std::span<const double> cells)
 {
     if (cells.empty()) throw std::invalid_argument("a strip profile needs at least one cell");
     StripProfile p;

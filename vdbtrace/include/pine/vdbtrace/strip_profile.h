@@ -7,6 +7,7 @@
 #include "pine/vdbtrace/geometry.h"
 
 #include <cstddef>
+#include <span>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -19,7 +20,7 @@ public:
     static StripProfile constant(double value);
     /// cells[k] at the centre of cell k of equal cells over xi in [-R, R], in order of xi;
     /// read as piecewise constant. Throws std::invalid_argument for no cells.
-    static StripProfile sampled(const std::vector<double>& cells);
+    static StripProfile sampled(std::span<const double> cells);
 
     bool isConstant() const { return mPrefix.empty(); }
     /// A sampled profile's cells, as given to sampled(); none for a constant.
