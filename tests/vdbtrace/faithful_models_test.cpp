@@ -78,6 +78,12 @@ double totalLight(const RenderResult& r)
     return sum;
 }
 
+double luminanceAt(const Image& image, int x, int y)
+{
+    const float* c = image.pixel(x, y);
+    return luminance(Vec3(c[0], c[1], c[2]));
+}
+
 double needles(double angle_deg, unsigned seed)
 {
     GeometryOptions g;
@@ -382,10 +388,7 @@ std::pair<double, double> halves(const RenderResult& r)
     double lower = 0.0, upper = 0.0;
     for (int y = 0; y < r.image.height; ++y) {
         for (int x = 0; x < r.image.width; ++x) {
-            const std::size_t i = 4 * (std::size_t(y) * r.image.width + x);
-            const double l =
-                luminance(Vec3(r.image.rgba[i], r.image.rgba[i + 1], r.image.rgba[i + 2]));
-            (2 * y < r.image.height ? upper : lower) += l;
+            (2 * y < r.image.height ? upper : lower) += luminanceAt(r.image, x, y);
         }
     }
     return {lower, upper};
@@ -519,10 +522,7 @@ double underTheRod(bool rod, int level, unsigned seed, bool needles)
     double sum = 0.0;
     for (int y = 0; y < r.image.height; ++y) {
         if (std::abs(y + 0.5 - 0.5 * r.image.height) > 3.0 * rowsPerCm) continue;
-        for (int x = 0; x < r.image.width; ++x) {
-            const std::size_t i = 4 * (std::size_t(y) * r.image.width + x);
-            sum += luminance(Vec3(r.image.rgba[i], r.image.rgba[i + 1], r.image.rgba[i + 2]));
-        }
+        for (int x = 0; x < r.image.width; ++x) sum += luminanceAt(r.image, x, y);
     }
     return sum;
 }
