@@ -531,11 +531,12 @@ TEST(FaithfulModels, ARodsShadowFallsOnTheRearHalfAlone)
 {
     // The rod's shadow edge lies inside the bough's depth, where level 2 places each needle's
     // shadow line at its own depth and level 3 at three points along each half's chord
-    // (shadowAcross). Measured 2026-12-05: needles 0.816 (4 rolls); level 2 0.801, level 3
-    // 0.791. Without the rod's shadow they would read 1; with a rod over the whole bough, 0
+    // (shadowAcross). Measured 2026-12-05 in LongBough's frame: needles 0.817 (4 rolls); level
+    // 2 0.795, level 3 0.796 (in a 160 x 120 frame 6 degrees high: 0.816, 0.801, 0.791).
+    // Without the rod's shadow they would read 1; with a rod over the whole bough, 0
     // (measured: direct light alone). Level 3's points weighted by where the exact law's lit
-    // needles lie along the chord (not kept: docs/models.md, "Where along the chord") read 0.774
-    // with three points a half and 0.824 with six.
+    // needles lie along the chord (not kept: docs/models.md, "Where along the chord") read, in that
+    // smaller frame, 0.774 with three points a half and 0.824 with six.
     constexpr int kRolls = 4;
     double needles = 0.0;
     for (unsigned seed = 1; seed <= kRolls; ++seed) {
