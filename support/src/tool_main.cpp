@@ -7,6 +7,7 @@
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <vector>
 
 namespace pine::tool {
 namespace {
@@ -43,7 +45,7 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
 {
     int threads = 0;
     app.add_option("--threads", threads, "Worker threads (default: all cores)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(wholeNumberAtLeast(0));
     app.add_flag("--quiet,-q", gQuiet, "Only warnings and errors on stderr (no progress)");
     app.set_version_flag("--version", std::string(name) + " " + PINE_TOOL_VERSION);
     for (CLI::App* sub : app.get_subcommands({})) {
@@ -53,7 +55,14 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         if (e.get_exit_code() == 0) return app.exit(e);  // --help
-        errorLine(std::string(name) + ": " + oneLine(e.what()) + " (see --help)");
+        // CLI11 checks what is required before what is left over, so that a misspelt option
+        // would be reported as the option it failed to be ("--out is required"): name it.
+        // (remaining() lists them last first.)
+        std::vector<std::string> unknown = app.remaining(true);
+        std::reverse(unknown.begin(), unknown.end());
+        const std::string why =
+            unknown.empty() ? std::string(e.what()) : std::string(CLI::ExtrasError(unknown).what());
+        errorLine(std::string(name) + ": " + oneLine(why) + " (see --help)");
         return 2;
     }
     std::unique_ptr<tbb::global_control> limit;
@@ -112,6 +121,21 @@ CLI::Validator positiveNumber()
             return "must be a number > 0, got '" + text + "'";
         },
         "> 0");
+}
+
+CLI::Validator wholeNumberAtLeast(long least)
+{
+    return CLI::Validator(
+        [least](std::string& text) -> std::string {
+            try {
+                std::size_t used = 0;
+                const long v = std::stol(text, &used);
+                if (used == text.size() && v >= least) return {};
+            } catch (const std::exception&) {
+            }
+            return "must be a whole number >= " + std::to_string(least) + ", got '" + text + "'";
+        },
+        ">= " + std::to_string(least));
 }
 
 double peakMemoryMiB()

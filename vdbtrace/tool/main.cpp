@@ -1249,10 +1249,11 @@ int main(int argc, char** argv)
     renderCmd->add_option("--method", method, methods)->capture_default_str();
     vdbtrace::MethodSettings settings;
     std::vector<fs::path> gridFiles;
-    renderCmd->add_option("--voxel-size", settings.voxelSize_cm,
-                          "reference: voxel size of the baked boughs, cm")
+    renderCmd
+        ->add_option("--voxel-size", settings.voxelSize_cm,
+                     "reference: voxel size of the baked boughs, cm")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(tool::positiveNumber());
     renderCmd->add_option("--grids", gridFiles,
                           "reference: baked .vdb files (bake tree/scene) instead of baking now")
         ->check(CLI::ExistingFile);

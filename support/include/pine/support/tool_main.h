@@ -33,6 +33,8 @@ void errorLine(const std::string& text);
 
 /// A finite number > 0 (CLI::PositiveNumber lets nan and inf through and prints DBL_MAX).
 CLI::Validator positiveNumber();
+/// A whole number >= least, named in its message (CLI::NonNegativeNumber's prints DBL_MAX).
+CLI::Validator wholeNumberAtLeast(long least);
 
 /// The process's peak resident memory so far, in MiB (for the tools' summary lines).
 double peakMemoryMiB();
