@@ -10,6 +10,8 @@
 #include <istream>
 #include <ostream>
 #include <set>
+#include <string>
+#include <vector>
 
 namespace pine::analytic::tool {
 namespace {
@@ -166,13 +168,28 @@ json evaluateBough(CaseReader& r, const Vec3& axis, const Vec3& L, const Vec3& V
 }
 
 // Builds the JSON of one line while remembering the last key read, so that a number JSON
-// cannot hold (1e999 overflows a double) is reported against its key, not as a bare parse error.
+// cannot hold (1e999 overflows a double) is reported against its key, not as a bare parse error,
+// and refusing a key an object already has (the JSON would keep the last, silently).
 class KeyTrackingParser : public nlohmann::detail::json_sax_dom_parser<json> {
 public:
     explicit KeyTrackingParser(json& result) : json_sax_dom_parser(result, false) {}
+    bool start_object(std::size_t n)
+    {
+        mKeys.emplace_back();
+        return json_sax_dom_parser::start_object(n);
+    }
+    bool end_object()
+    {
+        mKeys.pop_back();
+        return json_sax_dom_parser::end_object();
+    }
     bool key(json::string_t& k)
     {
         mLastKey = k;
+        if (!mKeys.back().insert(k).second) {
+            mDuplicate = true;
+            return false;
+        }
         return json_sax_dom_parser::key(k);
     }
     bool parse_error(std::size_t position, const std::string& token,
@@ -183,12 +200,14 @@ public:
         return json_sax_dom_parser::parse_error(position, token, e);
     }
     bool overflow() const { return mOverflow; }
+    bool duplicate() const { return mDuplicate; }
     const std::string& lastKey() const { return mLastKey; }
     const std::string& message() const { return mMessage; }
 
 private:
     std::string mLastKey, mMessage;
-    bool mOverflow = false;
+    bool mOverflow = false, mDuplicate = false;
+    std::vector<std::set<std::string>> mKeys;  ///< of each object open
 };
 
 json parseLine(const std::string& line)
@@ -197,6 +216,7 @@ json parseLine(const std::string& line)
     KeyTrackingParser parser(result);
     if (!json::sax_parse(line, &parser)) {
         if (parser.overflow()) throw CaseError(parser.lastKey(), "must be finite");
+        if (parser.duplicate()) throw CaseError(parser.lastKey(), "given twice");
         throw json::parse_error::create(101, 0, parser.message(), nullptr);
     }
     return result;

@@ -91,6 +91,8 @@ TEST(EvalTool, BadLinesNameLineAndKeyAndExitTwo)
         {R"({"level":"needle","axis":[0,0,1],"L":[1,0,"x"],"V":[0,1,0],"exponent":5})", "L"},
         {R"({"level":"needle","axis":[0,0,1],"L":[1,-1e999,0],"V":[0,1,0],"exponent":5})", "L"},
         {R"({"level":"needle","axis":[0,0,1],"L":[1,0,0],"V":[0,1,0],"exponent":5,"apperture":1})", "apperture"},
+        // A key given twice: JSON keeps the last, which would hide the first's bad value.
+        {R"({"level":"needle","axis":[0,0,1],"L":[1,0,0],"V":[0,1,0],"exponent":-5,"exponent":2})", "exponent"},
         {R"({"level":"leaf","axis":[0,0,1],"L":[1,0,0],"V":[0,1,0]})", "level"},
         {R"({"level":"cone","axis":[0,0,1],"L":[1,0,0],"V":[0,1,0],"radius":-0.05,"length":4,"aperture":0.4,"needles_per_cone":12,"exponent":50})", "radius"},
         {R"({"level":"cone","axis":[0,0,1],"L":[1,0,0],"V":[0,1,0],"radius":0.05,"length":4,"aperture":2.0,"needles_per_cone":12,"exponent":50})", "aperture"},
