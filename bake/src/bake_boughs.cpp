@@ -16,6 +16,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <sstream>
 #include <string>
 
 namespace pine::bake {
@@ -153,13 +154,22 @@ openvdb::GridBase::Ptr makeGrid(const FieldInfo& info, const openvdb::math::Tran
 
 }  // namespace
 
+void checkVoxelSize(double voxelSize_cm)
+{
+    constexpr double kMost_cm = 1e5;
+    if (!(std::isfinite(voxelSize_cm) && voxelSize_cm > 0.0 && voxelSize_cm <= kMost_cm)) {
+        std::ostringstream why;
+        why << "voxel size must be > 0 and at most " << kMost_cm << " cm (a kilometre), got "
+            << voxelSize_cm;
+        throw BakeError(why.str());
+    }
+}
+
 TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& settings)
 {
     openvdb::initialize();
     const double h = settings.voxelSize_cm;
-    if (!(std::isfinite(h) && h > 0.0)) {
-        throw BakeError("bake: voxel size must be finite and > 0, got " + std::to_string(h));
-    }
+    checkVoxelSize(h);
     if (settings.pyramidLevels < 1 || settings.pyramidLevels > 16) {
         throw BakeError("bake: pyramid levels must be in [1, 16], got " +
                         std::to_string(settings.pyramidLevels));

@@ -101,6 +101,7 @@ bake::BakeSettings forScene(bake::BakeSettings settings, const std::string& law,
                             const scenes::Scene& scene)
 {
     settings.extinctionLaw = law.empty() ? scene.render.model.extinctionLaw : law;
+    bake::checkVoxelSize(settings.voxelSize_cm);
     return settings;
 }
 
@@ -141,8 +142,6 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
               const Output& output, const fs::path& dir, double maxMemoryGiB)
 {
     const auto start = std::chrono::steady_clock::now();
-    io::checkWritableFolder(dir);
-    io::checkWritable(treeFile(dir, 0));
     const scenes::Scene scene = scenes::loadScene(sceneFile);
     const bake::BakeSettings settings = forScene(common, law, scene);
     const std::size_t n = scene.trees.size();
@@ -158,6 +157,9 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
                                meshBeside(treeFile(dir, i)), listFile},
                               {sceneFile});
     }
+    // The folder made only once nothing above refuses the run.
+    io::checkWritableFolder(dir);
+    io::checkWritable(treeFile(dir, 0));
     Totals totals;
     std::vector<bake::ProxyInstance> instances(n);
     tool::Progress progress("bake:");

@@ -20,6 +20,10 @@ expect_error "unwritable output, bad scene" 2 "no/such/dir" -- tree "$work/broke
 expect_error "no such tree" 2 "no tree 5" -- tree "$bough" --tree 5 --voxel-size 1 --out "$work/a.vdb"
 expect_error "zero voxel size" 2 "voxel-size" -- tree "$bough" --tree 0 --voxel-size 0 --out "$work/a.vdb"
 expect_error "negative voxel size" 2 "voxel-size" -- scene "$bough" --voxel-size -1 --out-dir "$work"
+# Near 1e308 OpenVDB cannot invert the grid's transform: refused before the bake, no folder made.
+expect_error "huge voxel size" 2 "voxel size must be > 0 and at most 100000 cm" -- tree "$bough" --tree 0 --voxel-size 1e308 --out "$work/a.vdb"
+expect_error "huge voxel size, all trees" 2 "at most 100000 cm" -- scene "$bough" --voxel-size 1e308 --out-dir "$work/never"
+[ ! -e "$work/never" ] || fail "a refused scene bake made its folder"
 expect_error "bad levels" 2 "levels" -- tree "$bough" --tree 0 --voxel-size 1 --levels 0 --out "$work/a.vdb"
 expect_error "missing option" 2 "out" -- tree "$bough" --tree 0 --voxel-size 1
 expect_error "no subcommand" 2 "subcommand" --

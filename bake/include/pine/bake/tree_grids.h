@@ -100,9 +100,13 @@ struct TreeGrids {
     void setGrid(Field field, const openvdb::GridBase::Ptr& grid);
 };
 
+/// Throws BakeError unless `voxelSize_cm` is > 0 and at most a kilometre (a voxel that holds
+/// whole forests as one value; near 1e308 OpenVDB cannot invert its transform).
+void checkVoxelSize(double voxelSize_cm);
+
 /// Voxelizes the boughs (not the branches: the tracers draw those as cylinders). Boughs are
 /// split among TBB threads; the result does not depend on the split (ties keep the bough listed
-/// first). Throws BakeError for a voxel size that is not finite and > 0, pyramid levels
+/// first). Throws BakeError for a voxel size checkVoxelSize refuses, pyramid levels
 /// outside [1, 16], or a bough outside its domain (non-finite, phi outside (0, pi/2], a
 /// negative size, dh <= 0); zero-size boughs bake to nothing.
 TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& settings);
