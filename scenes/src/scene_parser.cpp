@@ -52,7 +52,7 @@ Camera readCamera(const Json& value, const Where& where)
 }
 
 constexpr long long kMaxFrame = 9999999;
-constexpr long long kMaxFrames = 100000;
+constexpr long long kMaxFrames = CameraPath::kMaxFrames;
 
 // "camera_path": keys that each change what they name of the camera before them (the first
 // key, of the still camera), the frames to render and how to interpolate.

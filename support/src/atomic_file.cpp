@@ -199,6 +199,26 @@ void checkOutputsApart(const std::vector<fs::path>& outputs, const std::vector<f
     }
 }
 
+void checkFolderSparesInputs(const fs::path& folder,
+                             const std::function<bool(const std::string&)>& writes,
+                             const std::vector<fs::path>& inputs)
+{
+    for (const fs::path& in : inputs) {
+        if (in.empty()) continue;
+        std::error_code error;
+        const fs::path target = fs::canonical(in, error);
+        for (const fs::path& file : {in, error ? in : target}) {
+            const fs::path parent = file.has_parent_path() ? file.parent_path() : fs::path(".");
+            const std::string name = file.filename().string();
+            if (writes(name) && sameFile(parent, folder)) {
+                throw InputError("cannot write into '" + folder.string() + "': this run writes '" +
+                                 name + "' there, and '" + in.string() +
+                                 "' is an input of this run");
+            }
+        }
+    }
+}
+
 void checkWritableFolder(const fs::path& folder)
 {
     std::error_code error;

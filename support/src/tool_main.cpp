@@ -14,6 +14,7 @@
 #include <iostream>
 #include <memory>
 #include <new>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -136,6 +137,28 @@ CLI::Validator wholeNumberAtLeast(long least)
             return "must be a whole number >= " + std::to_string(least) + ", got '" + text + "'";
         },
         ">= " + std::to_string(least));
+}
+
+CLI::Validator numberIn(double least, double most)
+{
+    const auto shown = [](double v) {
+        std::ostringstream s;
+        s << v;
+        return s.str();
+    };
+    const std::string wanted =
+        std::isinf(most) ? ">= " + shown(least) : "from " + shown(least) + " to " + shown(most);
+    return CLI::Validator(
+        [=](std::string& text) -> std::string {
+            try {
+                std::size_t used = 0;
+                const double v = std::stod(text, &used);
+                if (used == text.size() && std::isfinite(v) && v >= least && v <= most) return {};
+            } catch (const std::exception&) {
+            }
+            return "must be a number " + wanted + ", got '" + text + "'";
+        },
+        std::isinf(most) ? ">= " + shown(least) : "in [" + shown(least) + ", " + shown(most) + "]");
 }
 
 double peakMemoryMiB()

@@ -85,6 +85,35 @@ expect_error "many needles" 2 "needle cylinders" -- render "$src/scenes/paper-fo
 rm "$work/huge.json"
 [ -z "$(ls "$work" | grep -v -e '^out$' -e '^err$' -e '^broken.json$')" ] || fail "failed runs left files: $(ls "$work")"
 
+# A scene (or image) in a folder of reports, under a name the run writes there, is not
+# written over: each command that writes a folder refuses before any work.
+mkdir "$work/inplace"
+inplace() {  # NAME, then the command with @ for the copy's path
+    local name=$1 copy=$work/inplace/$1
+    shift
+    cp "$src/scenes/bough.json" "$copy"
+    local args=()
+    for a in "$@"; do args+=("${a//@/$copy}"); done
+    expect_error "an input named $name in the output folder" 2 "is an input of this run" -- "${args[@]}"
+    cmp -s "$src/scenes/bough.json" "$copy" || fail "a refused run changed its input $name"
+    rm "$copy"
+}
+inplace report.md compare @ --out-dir "$work/inplace" --quick --resolution 8x6 --no-plot
+inplace trees.csv compare @ --out-dir "$work/inplace" --quick --resolution 8x6 --no-plot
+inplace frames.csv animate-compare @ --out-dir "$work/inplace" --resolution 8x6 --no-plot
+inplace growth.csv bench @ --grow resolution --grow-steps 2 --grow-dir "$work/inplace" --no-plot --geometry-samples 0
+inplace step-1.json bench @ --grow resolution --grow-steps 2 --grow-dir "$work/inplace" --no-plot --geometry-samples 0
+# A later frame's preview, not only the first's.
+cp "$src/scenes/bough.json" "$work/inplace/a.0002.png"
+expect_error "a scene named as frame 2's preview" 2 "also an input" -- render "$work/inplace/a.0002.png" --out "$work/inplace/a.exr" --frames 1-3 --resolution 8x6
+cmp -s "$src/scenes/bough.json" "$work/inplace/a.0002.png" || fail "a refused animation changed its scene"
+[ "$(ls "$work/inplace")" = a.0002.png ] || fail "refused runs left files: $(ls "$work/inplace")"
+rm -r "$work/inplace"
+expect_error "frames past the limit" 2 "10000000 frames, more than 100000" -- render "$src/scenes/bough.json" --out "$work/a.exr" --frames 0-9999999
+# nan is no default: CLI11's ranges let it through.
+expect_error "a level blend of nan" 2 "level-blend: must be a number from 1 to 2, got 'nan'" -- render "$src/scenes/bough.json" --out "$work/a.exr" --level-blend nan
+expect_error "a law cache of nan" 2 "law-cache: must be a number from 1 to 1e+07, got 'nan'" -- render "$src/scenes/bough.json" --out "$work/a.exr" --law-cache nan
+
 # An existing output survives a failed render.
 echo keep >"$work/keep.exr"
 "$vdbtrace" render "$work/broken.json" --out "$work/keep.exr" 2>/dev/null
@@ -172,6 +201,16 @@ for r in j["trees"]:
     assert abs(r["coverage_bias"] - (ca / cb - 1)) < 1e-12, r
     assert abs(r["luminance_bias"] - ((la / ca) / (lb / cb) - 1)) < 1e-12, r
 PY2
+# diff: no folder named; an image in the folder as error.exr; a refused pair makes no folder.
+expect_error "diff into no folder" 2 "--out: no folder named" -- diff "$work/b.exr" "$work/g.exr" --out ''
+mkdir "$work/din" && cp "$work/b.exr" "$work/din/error.exr"
+expect_error "diff over its image" 2 "is an input of this run" -- diff "$work/din/error.exr" "$work/g.exr" --out "$work/din"
+cmp -s "$work/b.exr" "$work/din/error.exr" || fail "a refused diff changed its image"
+rm -r "$work/din"
+"$vdbtrace" render "$src/scenes/bough.json" --resolution 9x6 --out "$work/odd.exr" -q || fail "a 9x6 render failed"
+expect_error "diff of two sizes" 2 "differ in size" -- diff "$work/b.exr" "$work/odd.exr" --out "$work/dnew"
+[ ! -e "$work/dnew" ] || fail "a refused diff made its folder"
+expect_error "diff scale below 0" 2 "scale: must be a number >= 0, got '-1'" -- diff "$work/b.exr" "$work/g.exr" --out "$work/bd" --scale -1
 # --sample-seed 0 is the default pattern; another seed is another (independent) image. The
 # double-precision cylinders render what the native curves render but for rounding.
 "$vdbtrace" render "$src/scenes/bough.json" --method geometry --samples 2 --sample-seed 0 --out "$work/g0.exr" -q \

@@ -33,6 +33,15 @@ CompareRun runCompare(const CompareOptions& options)
         if (options.log) options.log(line);
     };
     const std::filesystem::path& dir = options.outDir;
+    // Its reports, the rows' images and previews, the plots.
+    io::checkFolderSparesInputs(
+        dir,
+        [](const std::string& name) {
+            const std::string ext = std::filesystem::path(name).extension().string();
+            return name == "report.md" || name == "report.csv" || name == "trees.csv" ||
+                   name == "flicker.csv" || ext == ".exr" || ext == ".png";
+        },
+        {options.sceneFile});
     io::checkWritableFolder(dir);
     loadImageIo();
     scenes::Scene scene = loadComparedScene(

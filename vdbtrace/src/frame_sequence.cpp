@@ -1,9 +1,11 @@
 #include "pine/vdbtrace/frame_sequence.h"
 
+#include "pine/scenes/camera.h"
 #include "pine/support/input_error.h"
 
 #include <charconv>
 #include <cstdio>
+#include <string>
 #include <system_error>
 
 namespace pine::vdbtrace {
@@ -26,6 +28,10 @@ FrameRange parseFrameRange(const std::string& text)
     ok = ok && at == end && r.last >= r.first && r.last <= 9999999;
     if (!ok) {
         throw InputError("--frames '" + text + "': expected A-B (0 <= A <= B) or one frame A");
+    }
+    if (r.count() > scenes::CameraPath::kMaxFrames) {
+        throw InputError("--frames '" + text + "': " + std::to_string(r.count()) +
+                         " frames, more than " + std::to_string(scenes::CameraPath::kMaxFrames));
     }
     return r;
 }

@@ -45,9 +45,11 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -96,7 +98,7 @@ struct ModelOverrides {
         cmd.add_option("--level-blend", levelBlend,
                        "multiscale: the band about each level threshold over which two levels "
                        "are mixed, as a ratio of q (1: none; render.level_blend)")
-            ->check(CLI::Range(1.0, 2.0));
+            ->check(tool::numberIn(1.0, 2.0));
         cmd.add_option("--bark", bark,
                        "multiscale: solid (the needles' roots inside the branch are hidden) or "
                        "line (the branch is the bough's axis, the paper's; render.bark)")
@@ -346,6 +348,25 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     io::checkOutputsApart({first, besideWith(first, ".png"),
                            levelPng ? besideWith(first, ".level.png") : fs::path(), firstStats},
                           inputs);
+    if (animation) {  // every frame's files, not only the first's (by name, then as files)
+        std::set<fs::path> names;  // the inputs' own and, where links, their targets'
+        for (const fs::path& in : inputs) {
+            std::error_code error;
+            const fs::path target = fs::canonical(in, error);
+            names.insert(in.filename());
+            if (!error) names.insert(target.filename());
+        }
+        for (int f = frameRange->first + 1; f <= frameRange->last; ++f) {
+            const fs::path exr = exrOf(f);
+            for (const fs::path& output :
+                 {exr, besideWith(exr, ".png"),
+                  levelPng ? besideWith(exr, ".level.png") : fs::path(), statsOf(f)}) {
+                if (!output.empty() && names.count(output.filename())) {
+                    io::checkOutputsApart({output}, inputs);
+                }
+            }
+        }
+    }
     if (leader) vdbtrace::loadImageIo();  // the others send their images to it
     // Frames of an interrupted job already rendered as this one would are kept: the leader
     // looks, every rank hears which are left.
@@ -984,6 +1005,13 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
             throw InputError(where.str());
         }
     }
+    io::checkFolderSparesInputs(
+        dir,
+        [](const std::string& name) {
+            const bool step = name.rfind("step-", 0) == 0 && fs::path(name).extension() == ".json";
+            return step || name == "growth.json" || name == "growth.csv" || name == "growth.png";
+        },
+        {sceneFile});
     io::checkWritableFolder(dir);
     const bool ownPeaks = tool::resetPeakMemory();
     if (!ownPeaks) {
@@ -1110,13 +1138,20 @@ bool plotCompare(const fs::path& dir)
 
 int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double scale)
 {
-    std::error_code ec;
-    fs::create_directories(outDir, ec);
-    io::checkWritable(outDir / "error.exr");
+    if (outDir.empty()) throw InputError("--out: no folder named");
+    io::checkFolderSparesInputs(outDir,
+                                [](const std::string& name) {
+                                    return name == "error.exr" || name == "error.png" ||
+                                           name == "errors.json";
+                                },
+                                {a, b});
+    // The images read and compared before the folder is made: a refused pair leaves nothing.
     vdbtrace::Metadata imageHeader, referenceHeader;
     const vdbtrace::Image image = vdbtrace::readExr(a, &imageHeader),
                           reference = vdbtrace::readExr(b, &referenceHeader);
     const vdbtrace::ImageErrors errors = vdbtrace::compareImages(image, reference);
+    io::checkWritableFolder(outDir);
+    io::checkWritable(outDir / "error.exr");
     const double shown = scale > 0.0 ? scale : std::max(errors.maxAbsolute, 1e-12);
     vdbtrace::writeExr(errors.error, outDir / "error.exr",
                        {{"pine:image", a.string()}, {"pine:reference", b.string()}});
@@ -1300,12 +1335,13 @@ int main(int argc, char** argv)
                           "multiscale: shade every bough hit at level 1, 2 or 3")
         ->check(CLI::Range(0, 3));
     double lawCacheMiB = 0.0;  // 0: keep every profile
-    renderCmd->add_option("--law-cache", lawCacheMiB,
-                          "multiscale: MiB the boughs' law profiles (views, shadows) may keep "
-                          "(default: all, or what --max-memory leaves them); the oldest are "
-                          "dropped and computed again, the same, if asked again (a landscape: "
-                          "1.3 GB kept, 64 MiB enough)")
-        ->check(CLI::Range(1.0, 1e7));
+    renderCmd
+        ->add_option("--law-cache", lawCacheMiB,
+                     "multiscale: MiB the boughs' law profiles (views, shadows) may keep "
+                     "(default: all, or what --max-memory leaves them); the oldest are "
+                     "dropped and computed again, the same, if asked again (a landscape: "
+                     "1.3 GB kept, 64 MiB enough)")
+        ->check(tool::numberIn(1.0, 1e7));
 
     bool scaling = false;
     auto* benchCmd = app.add_subcommand(
@@ -1336,7 +1372,7 @@ int main(int argc, char** argv)
         ->add_option("--law-cache", benchLawCacheMiB,
                      "MiB the multiscale runs' law profiles may keep, as render --law-cache "
                      "(default: all); the stats count those computed again")
-        ->check(CLI::Range(1.0, 1e7));
+        ->check(tool::numberIn(1.0, 1e7));
     std::string benchResolution;
     addResolution(*benchCmd, benchResolution,
                   "WxH instead of the camera's (same view, vertical field kept; with --grow, "
@@ -1361,7 +1397,7 @@ int main(int argc, char** argv)
     benchCmd
         ->add_option("--grow-factor", growFactor,
                      "What each step of --grow multiplies: trees, pixels or needles")
-        ->check(CLI::Range(1.1, 16.0))
+        ->check(tool::numberIn(1.1, 16.0))
         ->capture_default_str();
     benchCmd->add_option("--grow-dir", growDir, "Folder for --grow's outputs");
     benchCmd->add_flag("--no-plot", growNoPlot, "--grow: no growth.png (no python3 needed)");
@@ -1378,7 +1414,7 @@ int main(int argc, char** argv)
     diffCmd->add_option("--out", diffOut, "Folder for error.exr, error.png, errors.json")
         ->required();
     diffCmd->add_option("--scale", diffScale, "Error shown white in error.png (default: the max)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(tool::numberIn(0.0, std::numeric_limits<double>::infinity()));
 
     vdbtrace::CompareOptions compare;
     bool quick = false, noPlot = false, noBudget = false;

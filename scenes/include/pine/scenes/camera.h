@@ -35,6 +35,8 @@ struct CameraKey {
 /// holds still. The up vector is normalised after interpolation.
 struct CameraPath {
     enum class Interpolation { Smooth, Linear };
+    /// The most frames one job renders (a path's, or --frames): checked before any work.
+    static constexpr int kMaxFrames = 100000;
 
     std::vector<CameraKey> keys;  ///< frames strictly increasing; empty: no path
     Interpolation interpolation = Interpolation::Smooth;

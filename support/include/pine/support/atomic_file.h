@@ -59,6 +59,14 @@ bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
 void checkOutputsApart(const std::vector<std::filesystem::path>& outputs,
                        const std::vector<std::filesystem::path>& inputs);
 
+/// Throws InputError (one line naming the folder, the file and the input) when a run that
+/// writes files named as `writes` says into `folder` would overwrite one of `inputs`: an input
+/// lying in `folder` (itself, or the file it links to) under such a name. For the runs that
+/// write a folder of reports, whose names are theirs, not the user's.
+void checkFolderSparesInputs(const std::filesystem::path& folder,
+                             const std::function<bool(const std::string&)>& writes,
+                             const std::vector<std::filesystem::path>& inputs);
+
 /// Creates `folder` (and its parents) if missing, then checkWritable of a file in it.
 void checkWritableFolder(const std::filesystem::path& folder);
 
