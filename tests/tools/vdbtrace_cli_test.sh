@@ -19,6 +19,7 @@ expect_error "unknown option, scene missing" 2 "not expected: --bogus (see --hel
 expect_error "misspelt --out" 2 "not expected: --ot a.exr (see --help)" -- render "$src/scenes/bough.json" --ot a.exr
 expect_error "threads not a number" 2 "threads: must be a whole number >= 0, got 'abc'" -- render "$src/scenes/bough.json" --out "$work/a.exr" --threads abc
 expect_error "a voxel size of nan" 2 "voxel-size: must be a number > 0, got 'nan'" -- render "$src/scenes/bough.json" --method reference --out "$work/a.exr" --voxel-size nan
+expect_error "a voxel size of 1e308" 2 "voxel size must be > 0 and at most 100000 cm" -- render "$src/scenes/bough.json" --method reference --out "$work/a.exr" --voxel-size 1e308
 expect_error "another method's option" 2 "samples applies to --method geometry, not multiscale" -- render "$src/scenes/bough.json" --out "$work/a.exr" --samples 4
 expect_error "another method's option" 2 "voxel-size applies to --method reference, not geometry" -- render "$src/scenes/bough.json" --method geometry --out "$work/a.exr" --voxel-size 1
 [ "$("$vdbtrace" --version)" = "vdbtrace $(sed -n 's/^project(PineMultiscale VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt")" ] \

@@ -2,6 +2,7 @@
 #include "pine/bake/extinction_law.h"
 #include "pine/bake/resource_estimate.h"
 #include "pine/bake/tree_boughs.h"
+#include "pine/bake/tree_grids.h"
 #include "pine/scenes/scene.h"
 #include "pine/scenes/tree.h"
 #include "pine/support/atomic_file.h"
@@ -1497,6 +1498,7 @@ int main(int argc, char** argv)
                                      ", not " + method);
                 }
             }
+            if (renderCmd->count("--voxel-size")) bake::checkVoxelSize(settings.voxelSize_cm);
             if (!renderResolution.empty()) {
                 vdbtrace::parseResolution(renderResolution, frame.width, frame.height);
             }
