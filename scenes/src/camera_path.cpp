@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <numbers>
 #include <sstream>
 
@@ -79,6 +80,9 @@ std::string cameraProblem(const Camera& c)
 {
     const Vec3 view = c.lookAt_cm - c.position_cm;
     if (!(glm::length(view) > 0.0)) return "look_at equals position (no view direction)";
+    if (!std::isfinite(glm::length(view))) {
+        return "look_at lies too far from position for its distance to be a number";
+    }
     if (!(glm::length(glm::cross(glm::normalize(view), c.up)) >= 1e-6)) {
         return "up is parallel to the view direction (or zero)";
     }

@@ -31,6 +31,10 @@ Camera readCamera(const Json& value, const Where& where)
     if (!(glm::length(view) > 0.0)) {
         where.key("look_at").fail("equals position (no view direction)");
     }
+    // Each coordinate finite, their distance not: the view direction would be zero.
+    if (!std::isfinite(glm::length(view))) {
+        where.key("look_at").fail("lies too far from position for its distance to be a number");
+    }
     if (const Json* up = r.optional("up")) c.up = detail::readDirection(*up, where.key("up"));
     // An up vector along the view leaves the image's roll undefined.
     if (glm::length(glm::cross(glm::normalize(view), c.up)) < 1e-6) {

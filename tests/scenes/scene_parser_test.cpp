@@ -511,6 +511,11 @@ TEST(SceneParser, RejectsZeroVectors)
     j["camera"]["up"] = {0, 1, 0};
     j["camera"]["look_at"] = {1, 0, 120};  // view along +y, parallel to up
     expectError(j, "camera.up", "parallel to the view direction");
+    // Each coordinate finite, their difference not: no view direction either (it read as an
+    // up parallel to it).
+    j = fullScene();
+    j["camera"]["position"] = {1e308, -1e308, 1e308};
+    expectError(j, "camera.look_at", "too far from position");
 }
 
 TEST(SceneParser, RejectsZeroResolution)
