@@ -58,7 +58,7 @@ int run(const char* name, CLI::App& app, int argc, char** argv,
         if (e.get_exit_code() == 0) return app.exit(e);  // --help
         // CLI11 checks what is required before what is left over, so that a misspelt option
         // would be reported as the option it failed to be ("--out is required"): name it.
-        // (remaining() lists them last first.)
+        // (ExtrasError joins them last first.)
         std::vector<std::string> unknown = app.remaining(true);
         std::reverse(unknown.begin(), unknown.end());
         const std::string why =
@@ -130,7 +130,7 @@ CLI::Validator wholeNumberAtLeast(long least)
         [least](std::string& text) -> std::string {
             try {
                 std::size_t used = 0;
-                const long v = std::stol(text, &used);
+                const long v = std::stol(text, &used, 0);  // as CLI11 reads it: 010 is 8
                 if (used == text.size() && v >= least) return {};
             } catch (const std::exception&) {
             }

@@ -185,6 +185,11 @@ TEST(CameraPath, BadPathsAreRefusedNamingTheKeyOrTheFrame)
                          {"frame": 10, "position": [0, 10, 100], "look_at": [0, -10, 100]}],
                "interpolation": "linear"})",
             "camera_path: at frame 5", "look_at equals position");
+    // A key so far from its look-at that their distance overflows, each coordinate finite:
+    // the first frame moving towards it already does.
+    refused(R"({"keys": [{"frame": 0}, {"frame": 4, "position": [1e308, -1e308, 1e308]}],
+               "interpolation": "linear"})",
+            "camera_path: at frame 1", "too far from position");
     // A smooth curve overshoots its keys' field of view below 0.
     refused(R"({"keys": [{"frame": 0, "fov_deg": 170}, {"frame": 1, "fov_deg": 170},
                          {"frame": 2, "fov_deg": 1}, {"frame": 30, "fov_deg": 1}]})",

@@ -106,7 +106,7 @@ inplace growth.csv bench @ --grow resolution --grow-steps 2 --grow-dir "$work/in
 inplace step-1.json bench @ --grow resolution --grow-steps 2 --grow-dir "$work/inplace" --no-plot --geometry-samples 0
 # A later frame's preview, not only the first's.
 cp "$src/scenes/bough.json" "$work/inplace/a.0002.png"
-expect_error "a scene named as frame 2's preview" 2 "also an input" -- render "$work/inplace/a.0002.png" --out "$work/inplace/a.exr" --frames 1-3 --resolution 8x6
+expect_error "a scene named as frame 2's preview" 2 "is an input of this run" -- render "$work/inplace/a.0002.png" --out "$work/inplace/a.exr" --frames 1-3 --resolution 8x6
 cmp -s "$src/scenes/bough.json" "$work/inplace/a.0002.png" || fail "a refused animation changed its scene"
 [ "$(ls "$work/inplace")" = a.0002.png ] || fail "refused runs left files: $(ls "$work/inplace")"
 rm -r "$work/inplace"

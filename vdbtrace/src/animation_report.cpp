@@ -200,13 +200,12 @@ AnimationFlicker runAnimationCompare(const AnimationCompareOptions& o)
     const auto log = [&](const std::string& line) {
         if (o.log) o.log(line);
     };
-    // Its reports, the frames' strip and the plots.
+    // Its reports, the frames' strip and the plot.
     io::checkFolderSparesInputs(o.outDir,
                                 [](const std::string& name) {
-                                    const std::string ext =
-                                        std::filesystem::path(name).extension().string();
                                     return name == "report.md" || name == "flicker.csv" ||
-                                           name == "frames.csv" || ext == ".exr" || ext == ".png";
+                                           name == "frames.csv" || name == "strip.png" ||
+                                           name == "flicker_frames.png";
                                 },
                                 {o.sceneFile});
     io::checkWritableFolder(o.outDir);

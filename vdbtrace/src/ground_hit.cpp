@@ -80,7 +80,8 @@ bool hitGround(const scenes::Ground& g, const ConeRay& ray, double& t, Vec3& nor
         if ((p.z > top && ray.direction.z >= 0.0) || p.z < g.height_cm - 1e4) return false;
         a = b;
     }
-    return plane(leave, kNever);
+    // The march gave up (1e8 cm) before leaving the hill's reach: nothing seen past it.
+    return a >= leave && plane(leave, kNever);
 }
 
 }  // namespace pine::vdbtrace

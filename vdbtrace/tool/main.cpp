@@ -349,24 +349,24 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     io::checkOutputsApart({first, besideWith(first, ".png"),
                            levelPng ? besideWith(first, ".level.png") : fs::path(), firstStats},
                           inputs);
-    if (animation) {  // every frame's files, not only the first's (by name, then as files)
-        std::set<fs::path> names;  // the inputs' own and, where links, their targets'
-        for (const fs::path& in : inputs) {
-            std::error_code error;
-            const fs::path target = fs::canonical(in, error);
-            names.insert(in.filename());
-            if (!error) names.insert(target.filename());
-        }
+    if (animation) {  // every frame's files, not only the first's
+        std::set<std::string> images, stats;
         for (int f = frameRange->first + 1; f <= frameRange->last; ++f) {
             const fs::path exr = exrOf(f);
-            for (const fs::path& output :
-                 {exr, besideWith(exr, ".png"),
-                  levelPng ? besideWith(exr, ".level.png") : fs::path(), statsOf(f)}) {
-                if (!output.empty() && names.count(output.filename())) {
-                    io::checkOutputsApart({output}, inputs);
-                }
-            }
+            images.insert(exr.filename().string());
+            images.insert(besideWith(exr, ".png").filename().string());
+            if (levelPng) images.insert(besideWith(exr, ".level.png").filename().string());
+            if (!statsFile.empty()) stats.insert(statsOf(f).filename().string());
         }
+        const auto folderOf = [](const fs::path& file) {
+            return file.has_parent_path() ? file.parent_path() : fs::path(".");
+        };
+        const auto among = [](const std::set<std::string>& names) {
+            return [&names](const std::string& name) { return names.count(name) > 0; };
+        };
+        io::checkFolderSparesInputs(folderOf(out), among(images), inputs);
+        if (!statsFile.empty())
+            io::checkFolderSparesInputs(folderOf(statsFile), among(stats), inputs);
     }
     if (leader) vdbtrace::loadImageIo();  // the others send their images to it
     // Frames of an interrupted job already rendered as this one would are kept: the leader
