@@ -32,9 +32,14 @@ std::string temporaryPrefix(const fs::path& file)
 
 }  // namespace
 
+fs::path folderOf(const fs::path& file)
+{
+    return file.has_parent_path() ? file.parent_path() : fs::path(".");
+}
+
 int removeStaleTemporaries(const fs::path& file)
 {
-    const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    const fs::path folder = folderOf(file);
     const std::string prefix = temporaryPrefix(file);
     std::error_code error;
     int removed = 0;
@@ -55,7 +60,7 @@ fs::path temporaryBeside(const fs::path& file)
     static thread_local std::mt19937_64 rng{std::random_device{}()};
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(rng()));
-    const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    const fs::path folder = folderOf(file);
     // ".NAME.tmp-HEX" within NAME_MAX (255 bytes on Linux): NAME shortened if need be.
     return folder / (temporaryPrefix(file) + hex);
 }
@@ -157,7 +162,7 @@ void checkWritable(const fs::path& file)
     if (fs::exists(status) && !fs::is_regular_file(status)) {
         throw refuse("it is not a regular file (a device, a pipe or a socket)");
     }
-    const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    const fs::path folder = folderOf(file);
     if (const std::string why = probeFolder(folder, file); !why.empty()) throw refuse(why);
 }
 
@@ -208,7 +213,7 @@ void checkFolderSparesInputs(const fs::path& folder,
         std::error_code error;
         const fs::path target = fs::canonical(in, error);
         for (const fs::path& file : {in, error ? in : target}) {
-            const fs::path parent = file.has_parent_path() ? file.parent_path() : fs::path(".");
+            const fs::path parent = folderOf(file);
             const std::string name = file.filename().string();
             if (writes(name) && sameFile(parent, folder)) {
                 throw InputError("cannot write into '" + folder.string() + "': this run writes '" +

@@ -1,5 +1,6 @@
 #include "pine/support/folder_lock.h"
 
+#include "pine/support/atomic_file.h"
 #include "pine/support/input_error.h"
 
 #include <fcntl.h>
@@ -46,7 +47,7 @@ FolderLock::~FolderLock()
 
 fs::path FolderLock::of(const fs::path& file)
 {
-    return file.has_parent_path() ? file.parent_path() : fs::path(".");
+    return folderOf(file);
 }
 
 }  // namespace pine::io

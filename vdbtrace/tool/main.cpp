@@ -358,15 +358,13 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             if (levelPng) images.insert(besideWith(exr, ".level.png").filename().string());
             if (!statsFile.empty()) stats.insert(statsOf(f).filename().string());
         }
-        const auto folderOf = [](const fs::path& file) {
-            return file.has_parent_path() ? file.parent_path() : fs::path(".");
-        };
         const auto among = [](const std::set<std::string>& names) {
             return [&names](const std::string& name) { return names.count(name) > 0; };
         };
-        io::checkFolderSparesInputs(folderOf(out), among(images), inputs);
-        if (!statsFile.empty())
-            io::checkFolderSparesInputs(folderOf(statsFile), among(stats), inputs);
+        io::checkFolderSparesInputs(io::folderOf(out), among(images), inputs);
+        if (!statsFile.empty()) {
+            io::checkFolderSparesInputs(io::folderOf(statsFile), among(stats), inputs);
+        }
     }
     if (leader) vdbtrace::loadImageIo();  // the others send their images to it
     // Frames of an interrupted job already rendered as this one would are kept: the leader

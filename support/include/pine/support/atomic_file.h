@@ -40,6 +40,9 @@ int removeStaleTemporaries(const std::filesystem::path& file);
 /// callback writeAtomically's writers call on their temporary.
 void writeBytes(const std::filesystem::path& file, std::string_view bytes);
 
+/// The folder `file` lies in: its parent, or "." for a bare name.
+std::filesystem::path folderOf(const std::filesystem::path& file);
+
 /// writeAtomically of `text`, checking that every byte reached the disk.
 void writeTextAtomically(const std::filesystem::path& file, const std::string& text);
 
