@@ -7,14 +7,22 @@
 #include <limits>
 
 namespace pine::vdbtrace {
+namespace {
+
+// Where the ray's axis meets the plane z = height_cm, or -1 where it does not go down.
+double toBasePlane(const scenes::Ground& g, const ConeRay& ray)
+{
+    return ray.direction.z < -1e-12 ? (g.height_cm - ray.origin.z) / ray.direction.z : -1.0;
+}
+
+}  // namespace
 
 bool hitGround(const scenes::Ground& g, const ConeRay& ray, double& t, Vec3& normal)
 {
     using Kind = scenes::Ground::Kind;
     if (g.kind == Kind::None) return false;
     if (g.kind == Kind::Plane) {
-        if (ray.direction.z >= -1e-12) return false;
-        t = (g.height_cm - ray.origin.z) / ray.direction.z;
+        t = toBasePlane(g, ray);
         normal = Vec3(0, 0, 1);
         return t > 0.0;
     }
@@ -50,8 +58,7 @@ bool hitGround(const scenes::Ground& g, const ConeRay& ray, double& t, Vec3& nor
         leave = -1.0;
     }
     const auto plane = [&](double from, double to) {
-        if (ray.direction.z >= -1e-12) return false;
-        const double s = (g.height_cm - ray.origin.z) / ray.direction.z;
+        const double s = toBasePlane(g, ray);
         if (!(s >= from && s < to)) return false;
         t = s;
         normal = Vec3(0, 0, 1);
