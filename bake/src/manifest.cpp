@@ -79,6 +79,20 @@ std::optional<FileDigest> acceptedDigest(const fs::path& file)
     }
 }
 
+namespace {
+
+// A file to read whole: a folder or a device (/dev/zero) is named as such, not as missing.
+void requireRegularFile(const fs::path& file)
+{
+    std::error_code error;
+    if (!fs::exists(file, error)) throw BakeError("'" + file.string() + "': no such file");
+    if (!fs::is_regular_file(file, error)) {
+        throw BakeError("'" + file.string() + "': not a regular file");
+    }
+}
+
+}  // namespace
+
 std::string readVerified(const fs::path& file, FileDigest* digest)
 {
     const auto refuse = [&](const std::string& why) {
@@ -87,8 +101,8 @@ std::string readVerified(const fs::path& file, FileDigest* digest)
                          "it): " + why);
     };
     const fs::path manifest = manifestPath(file);
+    requireRegularFile(file);
     std::error_code error;
-    if (!fs::exists(file, error)) throw BakeError("'" + file.string() + "': no such file");
     if (!fs::is_regular_file(manifest, error)) {
         throw refuse("no manifest '" + manifest.filename().string() + "' beside it");
     }
@@ -132,8 +146,8 @@ std::string readVerified(const fs::path& file, FileDigest* digest)
 
 std::string readWhole(const fs::path& file)
 {
+    requireRegularFile(file);
     std::error_code error;
-    if (!fs::is_regular_file(file, error)) throw BakeError("'" + file.string() + "': no such file");
     const std::uintmax_t bytes = fs::file_size(file, error);
     if (error) throw BakeError("cannot read '" + file.string() + "': " + error.message());
     std::string content(bytes, '\0');

@@ -63,6 +63,10 @@ rm "$work/v/b.vdb" "$work/v/b.vdb.json" "$work/v/a.vdb.json"
 [ $? -eq 3 ] || fail "verify without a manifest: exit status is not 3: $(cat "$work/out")"
 grep -q "1 of 1 files read whole, 1 of them unverified" "$work/err" || fail "verify: $(cat "$work/err")"
 grep -q "a.vdb: unverified, .*no manifest 'a.vdb.json'" "$work/out" || fail "verify: $(cat "$work/out")"
+# A device is named as such, not as a missing file.
+"$tool" verify /dev/zero >"$work/out" 2>"$work/err"
+[ $? -eq 2 ] || fail "verify of a device: exit status is not 2"
+grep -q "^/dev/zero: refused: '/dev/zero': not a regular file$" "$work/out" || fail "verify of a device: $(cat "$work/out")"
 rm -r "$work/v"
 
 # One tree: the .vdb, its manifest and its branch mesh; one summary line.
