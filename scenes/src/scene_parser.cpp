@@ -4,6 +4,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -120,6 +121,19 @@ CameraPath readCameraPath(const Json& value, const Where& where, const Camera& s
     return path;
 }
 
+// A light's colour times its strength, within kMaxLightValue.
+void checkLightValue(const ObjectReader& r, const Vec3& colour, double strength,
+                     const std::string& key)
+{
+    const double channel = std::max({colour.x, colour.y, colour.z});
+    if (!(channel * strength <= kMaxLightValue)) {
+        r.where().key(key).fail(detail::formatNumber(strength) + " times the colour (its largest " +
+                                "channel " + detail::formatNumber(channel) +
+                                ") is more than float radiance can hold (at most " +
+                                detail::formatNumber(kMaxLightValue) + " in all)");
+    }
+}
+
 void readLights(const Json& value, const Where& where, Scene& scene)
 {
     if (!value.is_array() || value.empty()) where.fail("must be an array of at least one light");
@@ -131,6 +145,7 @@ void readLights(const Json& value, const Where& where, Scene& scene)
             l.position_cm = r.vec3("position");
             l.colour = r.colour("colour", Range::atLeast(0), kWhite);
             l.intensity = r.number("intensity", Range::atLeast(0), l.intensity);
+            checkLightValue(r, l.colour, l.intensity, "intensity");
             scene.pointLights.push_back(l);
         } else if (type == "directional") {
             DirectionalLight l;
@@ -138,6 +153,7 @@ void readLights(const Json& value, const Where& where, Scene& scene)
                                                    r.where().key("direction"));
             l.colour = r.colour("colour", Range::atLeast(0), kWhite);
             l.irradiance = r.number("irradiance", Range::atLeast(0), l.irradiance);
+            checkLightValue(r, l.colour, l.irradiance, "irradiance");
             scene.directionalLights.push_back(l);
         } else {
             r.where().key("type").fail("must be \"point\" or \"directional\" (is \"" + type +
@@ -201,7 +217,7 @@ RenderSettings readRender(const Json& value, const Where& where)
 {
     ObjectReader r(value, where);
     RenderSettings s;
-    s.background = r.colour("background", Range::atLeast(0), s.background);
+    s.background = r.colour("background", Range::closed(0, kMaxLightValue), s.background);
     const std::string preset = r.string("preset", "faithful");
     if (preset == "paper") {
         s.model = ModelChoices::paper();

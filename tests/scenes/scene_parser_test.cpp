@@ -427,6 +427,27 @@ TEST(SceneParser, RejectsNegativeAndZeroSizes)
     }
 }
 
+TEST(SceneParser, RejectsALightTooBrightForFloatRadiance)
+{
+    // Radiance is written as float: a light whose colour times its strength passes 1e30 would
+    // overflow only after the render. The bound is on the product, whichever factor is large.
+    json j = fullScene();
+    j["lights"][0]["intensity"] = 1e308;
+    expectError(j, "lights[0].intensity", "more than float radiance can hold (at most 1e+30");
+    j = fullScene();
+    j["lights"][1]["colour"] = {1e16, 1, 1};
+    j["lights"][1]["irradiance"] = 1e15;
+    expectError(j, "lights[1].irradiance", "its largest channel 1e+16");
+    j = fullScene();
+    j["render"]["background"] = {0, 0, 1e31};
+    expectError(j, "render.background[2]", "must be in [0, 1e+30]");
+    // At the bound, accepted.
+    j = fullScene();
+    j["lights"][0]["colour"] = {1, 1, 1};
+    j["lights"][0]["intensity"] = 1e30;
+    EXPECT_EQ(errorOf(j), "");
+}
+
 TEST(SceneParser, RejectsWrongTypesAndShapes)
 {
     json j = fullScene();

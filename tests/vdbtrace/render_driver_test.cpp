@@ -97,6 +97,24 @@ TEST(RenderDriver, EveryPixelIsCountedByLevelEvenWithoutLevels)
     for (const float level : r.image.aovs.at("level")) EXPECT_EQ(level, 0.0f);
 }
 
+TEST(RenderDriver, RadianceTooLargeForAFloatIsAnErrorNotAPixel)
+{
+    // The scene format bounds a light (scenes::kMaxLightValue), but a point light's 1 / d^2
+    // near a surface is not bounded: a radiance past float's range is refused after the
+    // render, naming how many values, never written as an infinite pixel.
+    Frame f;
+    const ScriptedMethod method(
+        [](int x, int, FrontToBack& c) { c.add(opaque(5.0, x == 3 ? 1e39 : 0.5, 2, true)); });
+    try {
+        (void)renderImage(f.traced, method, {});
+        ADD_FAILURE() << "an overflowed render was returned";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("radiance overflowed: 6 pixel values"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(FrontToBack, CompositesOverInOrder)
 {
     FrontToBack c;

@@ -28,6 +28,11 @@ public:
     using InputError::InputError;
 };
 
+/// The most a light's colour times its irradiance (or intensity) may be, and the background's
+/// colour: radiance is written as float (at most 3.4e38), and a pixel sums several lights'
+/// reflections; a brighter light would overflow only after the render.
+inline constexpr double kMaxLightValue = 1e30;
+
 struct PointLight {
     Vec3 position_cm{0.0};
     Vec3 colour{1.0};
