@@ -23,7 +23,7 @@ std::string readProgram(const Json& value, const Where& where)
     for (char c : readString(value, where)) {
         if (std::isspace(static_cast<unsigned char>(c))) continue;
         if (!isLSystemSymbol(c)) {
-            where.fail(std::string("unknown symbol '") + c +
+            where.fail("unknown symbol '" + printable(std::string(1, c), /*asciiOnly=*/true) +
                        "' (the turtle reads F [ ] + - & ^ / \\ !; other letters are "
                        "non-terminals)");
         }

@@ -36,7 +36,7 @@ std::string oneLine(std::string text)
     for (char& c : text) {
         if (c == '\n') c = ' ';
     }
-    return text;
+    return printable(text);
 }
 
 }  // namespace

@@ -582,6 +582,18 @@ TEST(SceneParser, RejectsBadLSystems)
     EXPECT_NO_THROW(parseScene(j.dump(), "test.json"));
     j["species"]["fir"]["lsystem"]["max_segments"] = 0;
     expectError(j, "species.fir.lsystem.max_segments", "must be in [1, 4000000]");
+    // Bytes that are not text are shown as \xNN: a NUL ended the message where it was echoed,
+    // a byte of a multi-byte character alone is no character, a key's newline split the line.
+    j = fullScene();
+    j["species"]["fir"]["lsystem"]["axiom"] = std::string("A\0\x1b[31m", 7);
+    std::string message =
+        expectError(j, "species.fir.lsystem.axiom", "unknown symbol '\\x00' (the turtle reads");
+    j["species"]["fir"]["lsystem"]["axiom"] = "A\u00e9";
+    expectError(j, "species.fir.lsystem.axiom", "unknown symbol '\\xc3' (the turtle reads");
+    j = fullScene();
+    j["species"]["fir"]["lsystem"]["rules"]["B\n\x1b"] = "F";
+    message = expectError(j, "species.fir.lsystem.rules.B\\x0a\\x1b", "one letter");
+    EXPECT_EQ(message.find('\x1b'), std::string::npos) << message;
 }
 
 TEST(LSystem, ExpandedCountCountsWhatExpandingWouldHold)

@@ -71,6 +71,9 @@ expect_error "huge image" 2 "image 16384 x 16384 needs about" -- render "$work/h
 expect_error "tiny memory limit" 2 "more than --max-memory" -- render "$src/scenes/bough.json" --out "$work/a.exr" --max-memory 0.01
 newline=$'\n'
 expect_error "a name with a newline" 2 "no/such" -- render "$src/scenes/bough.json" --out "$work/no/such${newline}dir/a.exr"
+escape=$'\e'
+expect_error "a name with a terminal escape" 2 'no/such\\x1b\[31mdir' -- render "$src/scenes/bough.json" --out "$work/no/such${escape}[31mdir/a.exr"
+grep -q "$escape" "$work/err" && fail "an error line echoed a terminal escape: $(cat -v "$work/err")"
 expect_error "a bad option's value with a newline" 2 "is not available" -- render "$src/scenes/bough.json" --out "$work/a.exr" --method "geo${newline}metry"
 expect_error "fine voxels" 2 "voxels of 0.0001 cm" -- render "$src/scenes/three-firs.json" --method reference --voxel-size 1e-4 --out "$work/a.exr"
 expect_error "compare, huge resolution" 2 "at most 16384" -- compare "$src/scenes/bough.json" --resolution 100000x100000 --out-dir "$work/cmp"

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <stdexcept>
+#include <string>
+#include <string_view>
 
 namespace pine {
 
@@ -11,5 +13,26 @@ class InputError : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
 };
+
+/// `text` as an error line may show it: each control byte as \xNN (a NUL would end the
+/// message there, a newline split its line, an escape sequence drive the terminal), and with
+/// `asciiOnly` each byte of a multi-byte character too (one byte of it alone is not text).
+inline std::string printable(std::string_view text, bool asciiOnly = false)
+{
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string out;
+    out.reserve(text.size());
+    for (const char c : text) {
+        const auto byte = static_cast<unsigned char>(c);
+        if (byte >= 0x20 && byte != 0x7f && (byte < 0x80 || !asciiOnly)) {
+            out += c;
+            continue;
+        }
+        out += "\\x";
+        out += kHex[byte >> 4];
+        out += kHex[byte & 15];
+    }
+    return out;
+}
 
 }  // namespace pine
