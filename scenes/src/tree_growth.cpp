@@ -244,7 +244,7 @@ Tree growTree(const Species& species, const TreePlacement& placement)
     computeBounds(tree, placement.base_cm);
     tree.species = &species;
     // A forest's grown trees are all held while its boughs are made: no spare capacity (the
-    // paper's fir's vectors grew to a third more than they hold).
+    // paper's fir's vectors had grown to 512 slots for 348 segments and 330 boughs).
     tree.segments.shrink_to_fit();
     tree.boughs.shrink_to_fit();
     return tree;
