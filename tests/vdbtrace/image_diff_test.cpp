@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace pine::vdbtrace {
@@ -14,6 +15,42 @@ void fill(Image& image, int x, int y, double grey)
 {
     for (int c = 0; c < 3; ++c) image.pixel(x, y)[c] = float(grey);
     image.pixel(x, y)[3] = 1.0f;
+}
+
+TEST(ImageDiff, RefusesWhatNoErrorCanBeMeasuredOf)
+{
+    // A NaN or an infinite colour in either image (a damaged or overflowed render) is refused,
+    // naming the file: it crashed the error map's colour ramp. Two crops of different windows
+    // of one frame are not the same pixels, though the same size.
+    const auto message = [](const Image& a, const Image& b) -> std::string {
+        try {
+            (void)compareImages(a, b, "a.exr", "b.exr");
+        } catch (const ImageError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    Image plain(4, 3);
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 4; ++x) fill(plain, x, y, 0.5);
+    }
+    for (const float bad : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
+        Image damaged = plain;
+        damaged.pixel(2, 1)[1] = bad;
+        EXPECT_EQ(message(damaged, plain), "a.exr: 1 colour value is not finite (NaN or infinity)");
+        EXPECT_EQ(message(plain, damaged), "b.exr: 1 colour value is not finite (NaN or infinity)");
+    }
+    Image left = plain, right = plain;
+    left.frameWidth = right.frameWidth = 8;
+    left.frameHeight = right.frameHeight = 3;
+    right.originX = 4;
+    EXPECT_EQ(message(left, right),
+              "images show different windows of the frame: [0, 4) x [0, 3) "
+              "of 8x3 against [4, 8) x [0, 3) of 8x3");
+    EXPECT_EQ(message(left, plain),
+              "images show different windows of the frame: [0, 4) x [0, 3) "
+              "of 8x3 against the whole frame");
+    EXPECT_EQ(message(left, left), "");
 }
 
 TEST(ImageDiffScales, NoiseAveragesAwayAndABiasStays)

@@ -13,7 +13,7 @@ void ramp(double v, float* rgb)
 {
     static const float stops[5][3] = {
         {0, 0, 0}, {0.1f, 0.2f, 1}, {0.1f, 0.8f, 0.2f}, {1, 0.9f, 0.1f}, {1, 1, 1}};
-    v = std::clamp(v, 0.0, 1.0) * 4.0;
+    v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) * 4.0 : 0.0;  // int(NaN) is undefined
     const int i = std::min(3, int(v));
     const double f = v - i;
     for (int c = 0; c < 3; ++c) rgb[c] = float((1 - f) * stops[i][c] + f * stops[i + 1][c]);
@@ -54,12 +54,36 @@ const ImageErrors::AtScale* ImageErrors::atScale(int k) const
     return nullptr;
 }
 
-ImageErrors compareImages(const Image& image, const Image& reference)
+ImageErrors compareImages(const Image& image, const Image& reference, const std::string& imageName,
+                          const std::string& referenceName)
 {
     if (image.width != reference.width || image.height != reference.height) {
         throw ImageError("images differ in size: " + std::to_string(image.width) + "x" +
                          std::to_string(image.height) + " against " +
                          std::to_string(reference.width) + "x" + std::to_string(reference.height));
+    }
+    if (image.originX != reference.originX || image.originY != reference.originY ||
+        image.frameWidth != reference.frameWidth || image.frameHeight != reference.frameHeight) {
+        const auto window = [](const Image& i) {
+            if (i.frameWidth == 0) return std::string("the whole frame");
+            return "[" + std::to_string(i.originX) + ", " + std::to_string(i.originX + i.width) +
+                   ") x [" + std::to_string(i.originY) + ", " +
+                   std::to_string(i.originY + i.height) + ") of " + std::to_string(i.frameWidth) +
+                   "x" + std::to_string(i.frameHeight);
+        };
+        throw ImageError("images show different windows of the frame: " + window(image) +
+                         " against " + window(reference));
+    }
+    for (const auto& [what, i] : {std::pair{&imageName, &image}, {&referenceName, &reference}}) {
+        std::size_t bad = 0;
+        for (std::size_t k = 0; k < i->rgba.size(); ++k) {
+            bad += k % 4 != 3 && !std::isfinite(i->rgba[k]) ? 1 : 0;
+        }
+        if (bad > 0) {
+            throw ImageError(*what + ": " + std::to_string(bad) +
+                             (bad == 1 ? " colour value is" : " colour values are") +
+                             " not finite (NaN or infinity)");
+        }
     }
     ImageErrors e;
     e.error = Image(image.width, image.height);

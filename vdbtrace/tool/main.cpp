@@ -1148,7 +1148,8 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
     vdbtrace::Metadata imageHeader, referenceHeader;
     const vdbtrace::Image image = vdbtrace::readExr(a, &imageHeader),
                           reference = vdbtrace::readExr(b, &referenceHeader);
-    const vdbtrace::ImageErrors errors = vdbtrace::compareImages(image, reference);
+    const vdbtrace::ImageErrors errors =
+        vdbtrace::compareImages(image, reference, a.string(), b.string());
     io::checkWritableFolder(outDir);
     io::checkWritable(outDir / "error.exr");
     const double shown = scale > 0.0 ? scale : std::max(errors.maxAbsolute, 1e-12);

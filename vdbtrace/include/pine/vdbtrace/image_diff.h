@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <string>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -43,8 +44,12 @@ struct ImageErrors {
 /// The box-downsampling factors ImageErrors::byScale is measured at.
 inline constexpr int kErrorScales[] = {1, 2, 4, 8, 16};
 
-/// Throws ImageError if the sizes differ.
-ImageErrors compareImages(const Image& image, const Image& reference);
+/// Throws ImageError if the sizes differ, if the two are crops of different windows of a frame
+/// (Image::originX...), or if either has a colour that is not finite (NaN or infinity: no
+/// error can be measured against it), naming each as `imageName` and `referenceName`.
+ImageErrors compareImages(const Image& image, const Image& reference,
+                          const std::string& imageName = "the image",
+                          const std::string& referenceName = "the reference");
 
 /// False colours (black - blue - green - yellow - white) of the luminance error from 0 to
 /// `scale`, with a colour bar along the bottom (0 at the left, `scale` at the right; the scale is
