@@ -102,6 +102,11 @@ public:
         }
         const Vec2 lo = readVec2(region[0], at.index(0)), hi = readVec2(region[1], at.index(1));
         if (lo.x > hi.x || lo.y > hi.y) at.fail("must have x0 <= x1 and y0 <= y1");
+        // A tree is placed at x0 + u (x1 - x0): a width past a double's range places it at
+        // infinity or NaN.
+        if (!std::isfinite(hi.x - lo.x) || !std::isfinite(hi.y - lo.y)) {
+            at.fail("is wider than a number can hold (x1 - x0 and y1 - y0 must be finite)");
+        }
 
         double hMin = 0.0, hMax = 0.0;
         if (const Json* h = r.optional("height")) {

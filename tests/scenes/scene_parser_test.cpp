@@ -293,6 +293,22 @@ TEST(SceneParser, ScatterThatCannotKeepItsSpacingSaysSo)
     expectError(j, "trees[2].scatter.min_spacing", "cannot place 5 trees");
 }
 
+TEST(SceneParser, ScatterRegionWiderThanADoubleIsRefused)
+{
+    // Each corner finite, their distance not: the trees were placed at infinity (a render of
+    // nothing, a needle count of -2^63, exit 0).
+    json j = fullScene();
+    j["trees"][2]["scatter"]["region"] = {{-1e308, 0}, {1e308, 10}};
+    expectError(j, "trees[2].scatter.region", "x1 - x0 and y1 - y0 must be finite");
+    j["trees"][2]["scatter"]["region"] = {{0, -1e308}, {10, 1e308}};
+    expectError(j, "trees[2].scatter.region", "must be finite");
+    j["trees"][2]["scatter"]["region"] = {{-1e307, -1e307}, {1e307, 1e307}};
+    const Scene s = parseScene(j.dump(), "test.json");
+    for (const TreePlacement& p : s.trees) {
+        EXPECT_TRUE(std::isfinite(p.base_cm.x) && std::isfinite(p.base_cm.y)) << p.base_cm.x;
+    }
+}
+
 TEST(SceneParser, MalformedJsonGivesLineAndColumn)
 {
     // A trailing comma on line 3, at column 27.
