@@ -65,6 +65,13 @@ rm "$work/bright.json"
 [ -c /dev/null ] || fail "/dev/null is no longer a device"
 rm "$work/scene.json"
 # Resource bombs refused from the scene alone, before any tree is grown or pixel traced.
+# A bough of 1e12 cm bears 1e12 cones, each walked by the law: refused once the trees are
+# grown, before any pixel (it ran for hours without a progress line).
+sed 's/"segment": 6,/"segment": 1e12,/' "$src/scenes/bough.json" >"$work/long.json"
+grep -q 1e12 "$work/long.json" || fail "long.json: the segment was not changed"
+expect_error "a bough of a trillion cones" 2 "long.json: tree 0: a bough 1e+12 cm long bears 1.*e+12 cones .* more than 10000" -- render "$work/long.json" --resolution 16x12 --out "$work/long.exr"
+[ ! -e "$work/long.exr" ] || fail "a refused render was written"
+rm "$work/long.json"
 sed 's/"resolution": \[640, 480\]/"resolution": [16384, 16384]/' "$src/scenes/bough.json" >"$work/huge.json"
 grep -q 16384 "$work/huge.json" || fail "huge.json: the resolution was not changed"
 expect_error "huge image" 2 "image 16384 x 16384 needs about" -- render "$work/huge.json" --out "$work/a.exr" --max-memory 8

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <deque>
 #include <limits>
 #include <map>
@@ -589,7 +590,18 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
         const scenes::Species& species = *tree.species;
         const std::vector<bake::BoughSpec> specs = bake::treeBoughs(tree);
         for (std::size_t j = 0; j < specs.size(); ++j) {
-            if (!(glm::length(specs[j].tip_cm - specs[j].base_cm) > 0.0)) continue;
+            const double length = glm::length(specs[j].tip_cm - specs[j].base_cm);
+            if (!(length > 0.0)) continue;
+            const double dh = specs[j].needles.coneSpacing_cm;
+            if (!(length / dh <= kMaxConesPerBough)) {
+                char text[200];
+                std::snprintf(text, sizeof text,
+                              ": tree %zu: a bough %.3g cm long bears %.3g cones %.3g cm apart, "
+                              "more than %.0f (its species' lsystem.segment, length_decay or "
+                              "cone_spacing)",
+                              i, length, length / dh, dh, kMaxConesPerBough);
+                throw InputError(scene.source.string() + text);
+            }
             BoughDescription d;
             d.spec = specs[j];
             d.spec.base_cm = place(d.spec.base_cm);

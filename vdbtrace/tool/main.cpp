@@ -167,6 +167,11 @@ std::string describe(const scenes::Scene& scene, const vdbtrace::TracedScene& tr
     // Needle counts are expected values (cones times needles per cone, which may vary along a
     // bough): shown whole, as counts.
     const auto counted = [](double n, const char* one, const char* many) {
+        if (!(n < 1e15)) {  // past what a long long holds exactly (or at all)
+            char text[32];
+            std::snprintf(text, sizeof text, "%.3g ", n);
+            return text + std::string(many);
+        }
         const auto whole = static_cast<long long>(std::llround(n));
         return std::to_string(whole) + " " + (whole == 1 ? one : many);
     };

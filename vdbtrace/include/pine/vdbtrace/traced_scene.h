@@ -92,6 +92,12 @@ private:
 };
 
 /// What the scene says of one bough: what makeTracedBough prepares.
+/// The most cones one bough may bear (90 m of bough at the paper's spacing of 0.9 cm; a fir's
+/// boughs bear 10 to 300): every walk through a bough (the law's chords, levels 1-2, the
+/// self-shadowing) steps cone by cone, so a longer one runs for hours. Refused when the
+/// scene is traced, before any pixel.
+inline constexpr double kMaxConesPerBough = 1e4;
+
 struct BoughDescription {
     bake::BoughSpec spec;  ///< branch, needle parameters, albedo: what bake voxelizes too
     double specularWeight = 0.0;
