@@ -447,6 +447,22 @@ TEST(CompareRun, ParsesResolution)
     EXPECT_FALSE(parseResolution("64x", w, h));
     EXPECT_FALSE(parseResolution("0x48", w, h));
     EXPECT_FALSE(parseResolution("64x48x2", w, h));
+    // Past an int, each side: sscanf's %d read these as 32 x 24 (modulo 2^32).
+    for (const char* wrapped : {"4294967328x24", "-4294967264x24", "32x4294967320"}) {
+        EXPECT_FALSE(parseResolution(wrapped, w, h)) << wrapped;
+    }
+    EXPECT_FALSE(parseResolution(" 64x48", w, h));
+    EXPECT_FALSE(parseResolution("64x+48", w, h));
+    EXPECT_EQ(w, 64);  // untouched by what was refused
+    int crop[4] = {};
+    EXPECT_TRUE(parseIntegers("0,-1,16384,2147483647", ',', crop));
+    EXPECT_EQ(crop[1], -1);
+    EXPECT_EQ(crop[3], 2147483647);
+    EXPECT_FALSE(parseIntegers("0,0,4294967300,24", ',', crop));
+    EXPECT_FALSE(parseIntegers("0,0,2147483648,24", ',', crop));
+    EXPECT_FALSE(parseIntegers("0,0,4,4,", ',', crop));
+    EXPECT_FALSE(parseIntegers("0,0,4", ',', crop));
+    EXPECT_FALSE(parseIntegers("0,,4,4", ',', crop));
 }
 
 Image constantFrame(float value)

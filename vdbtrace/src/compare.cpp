@@ -7,21 +7,33 @@
 #include "pine/vdbtrace/image.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 
 namespace pine::vdbtrace {
 
+bool parseIntegers(std::string_view text, char separator, std::span<int> values)
+{
+    const char* at = text.data();
+    const char* const end = text.data() + text.size();
+    for (std::size_t k = 0; k < values.size(); ++k) {
+        if (k > 0 && (at == end || *at++ != separator)) return false;
+        const auto [next, error] = std::from_chars(at, end, values[k]);
+        if (error != std::errc() || next == at) return false;
+        at = next;
+    }
+    return at == end;
+}
+
 bool parseResolution(const std::string& text, int& width, int& height)
 {
-    int w = 0, h = 0, used = 0;
-    if (std::sscanf(text.c_str(), "%dx%d%n", &w, &h, &used) != 2) return false;
+    int v[2];
+    if (!parseIntegers(text, 'x', v)) return false;
     constexpr int kMaxSide = 16384;  // a scene's camera.resolution allows no more
-    if (std::size_t(used) != text.size() || w < 1 || h < 1 || w > kMaxSide || h > kMaxSide) {
-        return false;
-    }
-    width = w;
-    height = h;
+    if (v[0] < 1 || v[1] < 1 || v[0] > kMaxSide || v[1] > kMaxSide) return false;
+    width = v[0];
+    height = v[1];
     return true;
 }
 

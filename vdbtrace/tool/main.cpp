@@ -203,10 +203,7 @@ void checkBakedFrom(const fs::path& file, const bake::BakeProvenance& from, cons
 bool parseCrop(const std::string& text, vdbtrace::PixelWindow& window)
 {
     int v[4];
-    char tail = 0;
-    if (std::sscanf(text.c_str(), "%d,%d,%d,%d%c", &v[0], &v[1], &v[2], &v[3], &tail) != 4) {
-        return false;
-    }
+    if (!vdbtrace::parseIntegers(text, ',', v)) return false;
     if (v[0] < 0 || v[1] < 0 || v[2] <= v[0] || v[3] <= v[1]) return false;
     window = {v[0], v[1], v[2], v[3]};
     return true;
