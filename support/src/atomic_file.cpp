@@ -150,7 +150,7 @@ std::string probeFolder(const fs::path& folder, const fs::path& beside)
 
 }  // namespace
 
-void checkWritable(const fs::path& file)
+void checkWritableName(const fs::path& file)
 {
     const auto refuse = [&](const std::string& why) {
         return InputError("cannot write '" + file.string() + "': " + why);
@@ -162,8 +162,15 @@ void checkWritable(const fs::path& file)
     if (fs::exists(status) && !fs::is_regular_file(status)) {
         throw refuse("it is not a regular file (a device, a pipe or a socket)");
     }
+}
+
+void checkWritable(const fs::path& file)
+{
+    checkWritableName(file);
     const fs::path folder = folderOf(file);
-    if (const std::string why = probeFolder(folder, file); !why.empty()) throw refuse(why);
+    if (const std::string why = probeFolder(folder, file); !why.empty()) {
+        throw InputError("cannot write '" + file.string() + "': " + why);
+    }
 }
 
 bool sameFile(const fs::path& a, const fs::path& b)

@@ -64,6 +64,13 @@ expect_error "a light too bright for float radiance" 2 "lights\[0\].intensity: 1
 rm "$work/bright.json"
 [ -c /dev/null ] || fail "/dev/null is no longer a device"
 rm "$work/scene.json"
+# A folder where a preview goes is refused before the render, which it cost, and before any
+# other file is written (with --aov level the preview was written and the EXR not).
+mkdir "$work/pv.png" "$work/lv.level.png"
+expect_error "preview onto a folder" 2 "cannot write '.*pv.png': it is a folder" -- render "$src/scenes/bough.json" --resolution 8x6 --out "$work/pv.exr"
+expect_error "level preview onto a folder" 2 "cannot write '.*lv.level.png': it is a folder" -- render "$src/scenes/bough.json" --resolution 8x6 --aov level --out "$work/lv.exr"
+[ ! -e "$work/pv.exr" ] && [ ! -e "$work/lv.exr" ] && [ ! -e "$work/lv.png" ] || fail "a refused render wrote: $(ls "$work")"
+rmdir "$work/pv.png" "$work/lv.level.png"
 # Resource bombs refused from the scene alone, before any tree is grown or pixel traced.
 # A bough of 1e12 cm bears 1e12 cones, each walked by the law: refused once the trees are
 # grown, before any pixel (it ran for hours without a progress line).
@@ -492,6 +499,11 @@ grep -q "2 of 3 frames already rendered by this job, kept" "$work/err" || fail "
     --method geometry --samples 2 --out "$work/seq/f.exr" 2>"$work/err" || fail "another job: exit $?"
 grep -q "kept" "$work/err" && fail "another job's frames were kept"
 [ "$(grep -c 'seq/f.000[2-4].exr: 32x24' "$work/err")" -eq 3 ] || fail "another job did not render all 3 frames"
+# A later frame's preview or stats where a folder is: refused before the first frame.
+mkdir "$work/seq/g.0004.png"
+expect_error "a later frame's preview onto a folder" 2 "cannot write '.*g.0004.png': it is a folder" -- render "$src/scenes/three-firs.json" --frames 2-4 --resolution 8x6 --out "$work/seq/g.exr"
+rmdir "$work/seq/g.0004.png"
+[ -z "$(ls "$work/seq" | grep '^g\.')" ] || fail "a refused job wrote frames: $(ls "$work/seq")"
 # A frame beyond the path's own whose camera cannot render: refused by number.
 printf '%s' '{"camera": {"position": [0, -10, 100], "look_at": [0, 10, 100]},
  "camera_path": {"keys": [{"frame": 0}, {"frame": 10, "position": [0, 10, 100], "look_at": [0, -10, 100]}],

@@ -333,20 +333,28 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     };
     const fs::path first = animation ? exrOf(frameRange->first) : out;
     const fs::path firstStats = animation ? statsOf(frameRange->first) : statsFile;
+    const bool levelPng = std::find(aovs.begin(), aovs.end(), "level") != aovs.end();
+    if (levelPng && !method.levels) {
+        throw InputError("--aov level: method '" + methodName +
+                         "' has no levels (multiscale shades at the paper's levels)");
+    }
+    // Every file a frame writes, beside its EXR: a folder named as a preview was found only
+    // after the render, which it lost (and with --aov level, after the preview was written).
+    const auto previewsOf = [&](const fs::path& exr) {
+        std::vector<fs::path> previews = {besideWith(exr, ".png")};
+        if (levelPng) previews.push_back(besideWith(exr, ".level.png"));
+        return previews;
+    };
     // Only the leader writes (the other ranks' machines may not see its folders).
     if (leader) {
         io::checkWritable(first);
+        for (const fs::path& preview : previewsOf(first)) io::checkWritableName(preview);
         if (!statsFile.empty()) io::checkWritable(firstStats);
     }
     std::vector<fs::path> inputs = {sceneFile};
     for (const fs::path& g : gridFiles) {
         inputs.push_back(g);
         inputs.push_back(g.string() + ".json");
-    }
-    const bool levelPng = std::find(aovs.begin(), aovs.end(), "level") != aovs.end();
-    if (levelPng && !method.levels) {
-        throw InputError("--aov level: method '" + methodName +
-                         "' has no levels (multiscale shades at the paper's levels)");
     }
     io::checkOutputsApart({first, besideWith(first, ".png"),
                            levelPng ? besideWith(first, ".level.png") : fs::path(), firstStats},
@@ -356,9 +364,15 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         for (int f = frameRange->first + 1; f <= frameRange->last; ++f) {
             const fs::path exr = exrOf(f);
             images.insert(exr.filename().string());
-            images.insert(besideWith(exr, ".png").filename().string());
-            if (levelPng) images.insert(besideWith(exr, ".level.png").filename().string());
-            if (!statsFile.empty()) stats.insert(statsOf(f).filename().string());
+            for (const fs::path& preview : previewsOf(exr)) {
+                images.insert(preview.filename().string());
+                if (leader) io::checkWritableName(preview);
+            }
+            if (leader) io::checkWritableName(exr);
+            if (!statsFile.empty()) {
+                stats.insert(statsOf(f).filename().string());
+                if (leader) io::checkWritableName(statsOf(f));
+            }
         }
         const auto among = [](const std::set<std::string>& names) {
             return [&names](const std::string& name) { return names.count(name) > 0; };

@@ -52,6 +52,10 @@ void writeTextAtomically(const std::filesystem::path& file, const std::string& t
 /// guessed from permission bits: read-only mounts, ACLs and root all differ).
 void checkWritable(const std::filesystem::path& file);
 
+/// checkWritable without trying its folder: for the many files of one folder (an animation's
+/// frames) once checkWritable has tried it with one of them.
+void checkWritableName(const std::filesystem::path& file);
+
 /// Whether two paths name the same file: the same file if both exist (hard and symbolic links
 /// followed), else the same path once made absolute and resolved ("..", links of the folders).
 bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
