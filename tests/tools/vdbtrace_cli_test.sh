@@ -499,6 +499,20 @@ grep -q "2 of 3 frames already rendered by this job, kept" "$work/err" || fail "
     --method geometry --samples 2 --out "$work/seq/f.exr" 2>"$work/err" || fail "another job: exit $?"
 grep -q "kept" "$work/err" && fail "another job's frames were kept"
 [ "$(grep -c 'seq/f.000[2-4].exr: 32x24' "$work/err")" -eq 3 ] || fail "another job did not render all 3 frames"
+# The same job asking for stats renders again the frames that have none (it kept them all and
+# wrote no stats).
+"$vdbtrace" render "$src/scenes/three-firs.json" --frames 2-4 --resolution 32x24 \
+    --method geometry --samples 2 --out "$work/seq/f.exr" --stats "$work/seq/s.json" 2>"$work/err" ||
+    fail "stats on resume: exit $?"
+for f in 0002 0003 0004; do
+    [ -s "$work/seq/s.$f.json" ] || fail "stats on resume: no s.$f.json: $(grep -v % "$work/err" | head -3)"
+done
+rm "$work/seq/s.0003.json"
+"$vdbtrace" render "$src/scenes/three-firs.json" --frames 2-4 --resolution 32x24 \
+    --method geometry --samples 2 --out "$work/seq/f.exr" --stats "$work/seq/s.json" 2>"$work/err" ||
+    fail "stats on resume: exit $?"
+grep -q "2 of 3 frames already rendered by this job, kept" "$work/err" && [ -s "$work/seq/s.0003.json" ] ||
+    fail "stats on resume: frame 3's stats: $(grep -v % "$work/err" | head -3)"
 # A later frame's preview or stats where a folder is: refused before the first frame.
 mkdir "$work/seq/g.0004.png"
 expect_error "a later frame's preview onto a folder" 2 "cannot write '.*g.0004.png': it is a folder" -- render "$src/scenes/three-firs.json" --frames 2-4 --resolution 8x6 --out "$work/seq/g.exr"

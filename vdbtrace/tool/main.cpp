@@ -383,16 +383,19 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         }
     }
     if (leader) vdbtrace::loadImageIo();  // the others send their images to it
-    // Frames of an interrupted job already rendered as this one would are kept: the leader
-    // looks, every rank hears which are left.
+    // Frames of an interrupted job already rendered as this one would are kept, with their
+    // stats if this job asks for them (else rendered again to write them): the leader looks,
+    // every rank hears which are left.
     const std::string job =
         animation ? frameJobDigest(sceneFile, methodName, settings, gridFiles, model, frame, aovs)
                   : std::string();
     std::vector<int> toRender;
     if (animation) {
         if (leader) {
-            toRender = vdbtrace::framesLeft(*frameRange,
-                                            [&](int f) { return frameComplete(exrOf(f), job); });
+            toRender = vdbtrace::framesLeft(*frameRange, [&](int f) {
+                return frameComplete(exrOf(f), job) &&
+                       (statsFile.empty() || fs::is_regular_file(statsOf(f)));
+            });
         }
         vdbtrace::Bytes list(toRender.size() * sizeof(int));
         std::memcpy(list.data(), toRender.data(), list.size());
