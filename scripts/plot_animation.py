@@ -24,7 +24,8 @@ def main(folder):
         for row in csv.DictReader(f):
             s = series.setdefault(row["method"], ([], [], []))
             s[0].append(int(row["frame"]))
-            s[1].append(float(row["residual_rms"]))
+            # Empty at the first and last frames, which have no neighbours to be off the line of.
+            s[1].append(float(row["residual_rms"] or "nan"))
             s[2].append(float(row["mean_luminance"]))
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     for method, (frames, residual, luminance) in series.items():

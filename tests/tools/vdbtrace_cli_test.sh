@@ -476,6 +476,10 @@ done
 # has no error flicker.
 [ "$(tail -n +2 "$work/anim/flicker.csv" | wc -l)" -eq 20 ] || fail "flicker.csv: $(cat "$work/anim/flicker.csv")"
 [ "$(grep -c '^[2-5],' "$work/anim/frames.csv")" -eq 16 ] || fail "frames.csv: $(cat "$work/anim/frames.csv")"
+# The first and last frames have no residual: an empty field, never "nan".
+grep -qiw nan "$work/anim/frames.csv" && fail "frames.csv holds nan: $(cat "$work/anim/frames.csv")"
+[ "$(grep -c '^[25],[a-z_0-9]*,,[0-9]' "$work/anim/frames.csv")" -eq 8 ] ||
+    fail "frames.csv: the end frames' residuals: $(cat "$work/anim/frames.csv")"
 [ "$(grep -c '^truth_geometry_4spp,[a-z]*,[0-9]*,[0-9.e-]*,,' "$work/anim/flicker.csv")" -eq 5 ] ||
     fail "flicker.csv: the truth's rows: $(grep truth "$work/anim/flicker.csv")"
 [ "$(grep -c '^geometry_1spp,[a-z]*,[0-9]*,[0-9.e-]*,[0-9]' "$work/anim/flicker.csv")" -eq 5 ] ||

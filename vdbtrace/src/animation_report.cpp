@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -67,8 +68,12 @@ std::string framesCsv(const AnimationFlicker& a, const std::vector<int>& frameNu
     csv << "frame,method,residual_rms,mean_luminance\n" << std::setprecision(6);
     for (const AnimationRow& r : a.rows) {
         for (std::size_t t = 0; t < frameNumbers.size(); ++t) {
-            csv << frameNumbers[t] << ',' << r.method << ',' << r.flicker.residualPerFrame[t] << ','
-                << r.flicker.luminancePerFrame[t] << '\n';
+            // Empty where undefined (the first and last frames have no line through their
+            // neighbours), as flicker.csv leaves them: "nan" is no number a reader takes.
+            const double residual = r.flicker.residualPerFrame[t];
+            csv << frameNumbers[t] << ',' << r.method << ',';
+            if (std::isfinite(residual)) csv << residual;
+            csv << ',' << r.flicker.luminancePerFrame[t] << '\n';
         }
     }
     return csv.str();
