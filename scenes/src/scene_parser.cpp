@@ -104,7 +104,8 @@ CameraPath readCameraPath(const Json& value, const Where& where, const Camera& s
         where.key("frames").fail(std::to_string(path.frameCount()) + " frames, more than " +
                                  std::to_string(kMaxFrames));
     }
-    path.framesPerSecond = r.number("fps", Range::above(0.0), path.framesPerSecond);
+    // Written as a float in each frame's header: 1e-320 read as 0 there, 1e308 as inf.
+    path.framesPerSecond = r.number("fps", Range::closed(1e-3, 1e6), path.framesPerSecond);
     const std::string interpolation = r.string("interpolation", "smooth");
     if (interpolation == "linear") {
         path.interpolation = CameraPath::Interpolation::Linear;

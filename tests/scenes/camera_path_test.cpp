@@ -180,6 +180,10 @@ TEST(CameraPath, BadPathsAreRefusedNamingTheKeyOrTheFrame)
     refused(R"({"keys": [{"frame": 1, "fov_deg": 0}]})", "camera_path.keys[0].fov_deg",
             "must be in (0, 180)");
     refused(R"({"keys": [{"frame": 1, "up": [0, 0, 0]}]})", "camera_path.keys[0].up", "");
+    // fps is a float in each frame's header: 1e-320 was written there as 0, 1e308 as inf.
+    refused(R"({"keys": [{"frame": 1}], "fps": 1e-320})", "camera_path.fps",
+            "must be in [0.001, 1000000]");
+    refused(R"({"keys": [{"frame": 1}], "fps": 1e308})", "camera_path.fps", "must be in");
     // The look-at reaches the camera between keys.
     refused(R"({"keys": [{"frame": 0, "position": [0, -10, 100], "look_at": [0, 10, 100]},
                          {"frame": 10, "position": [0, 10, 100], "look_at": [0, -10, 100]}],
