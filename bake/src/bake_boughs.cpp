@@ -171,16 +171,16 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
     const double h = settings.voxelSize_cm;
     checkVoxelSize(h);
     if (settings.pyramidLevels < 1 || settings.pyramidLevels > 16) {
-        throw BakeError("bake: pyramid levels must be in [1, 16], got " +
+        throw BakeError("pyramid levels must be in [1, 16], got " +
                         std::to_string(settings.pyramidLevels));
     }
-    if (boughs.size() >= 0xFFFFFFFFu) throw BakeError("bake: too many boughs");
+    if (boughs.size() >= 0xFFFFFFFFu) throw BakeError("too many boughs to bake");
     std::vector<PreparedBough> prepared;
     prepared.reserve(boughs.size());
     for (std::size_t i = 0; i < boughs.size(); ++i) {
         prepared.emplace_back(boughs[i]);
         if (const char* why = prepared.back().invalidReason()) {
-            throw BakeError("bake: bough " + std::to_string(i) + ": " + why);
+            throw BakeError("baking bough " + std::to_string(i) + ": " + why);
         }
     }
 

@@ -33,7 +33,7 @@ void fillInactive(const FieldInfo& info, const TreeGrids& into, const TreeGrids&
 
 TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
 {
-    if (trees.empty()) throw BakeError("bake: no grids to merge");
+    if (trees.empty()) throw BakeError("no grids to merge");
     TreeGrids out;
     const TreeGrids& first = trees.front();
     out.voxelSize_cm = first.voxelSize_cm;
@@ -44,12 +44,12 @@ TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
     for (std::size_t i = 1; i < trees.size(); ++i) {
         const TreeGrids& t = trees[i];
         if (std::abs(t.voxelSize_cm - out.voxelSize_cm) > 1e-9 * out.voxelSize_cm) {
-            throw BakeError("bake: cannot merge grids of voxel sizes " +
+            throw BakeError("cannot merge grids of voxel sizes " +
                             std::to_string(out.voxelSize_cm) + " and " +
                             std::to_string(t.voxelSize_cm) + " cm");
         }
         if (t.extinctionLaw != out.extinctionLaw) {
-            throw BakeError("bake: cannot merge grids of extinction laws '" + out.extinctionLaw +
+            throw BakeError("cannot merge grids of extinction laws '" + out.extinctionLaw +
                             "' and '" + t.extinctionLaw + "'");
         }
         // What the trees before this one occupy, fixed while the fields are filled.
