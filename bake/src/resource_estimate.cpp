@@ -26,9 +26,9 @@ constexpr double kGiB = 1024.0 * 1024.0 * 1024.0;
 // profiles (multiscale: the view of level 3, 790 bytes with one light, and the opacity seen
 // from each light, 200: the stats' law_profiles count them); a bough of a grown tree, held by
 // every method until the boughs are made (its tree's segments and boughs: 155 bytes a bough on
-// the paper's fir; 20,000 firs without variants, all grown, peaked at 4.03 GiB where the
-// other parts sum to 3.23); a needle cylinder with Embree's BVH; a voxel of the six grids and
-// a light grid.
+// the paper's fir, 165 with a margin for the allocations; 20,000 firs without variants, all
+// grown, peaked at 4.03 GiB where the other parts sum to 3.23); a needle cylinder with Embree's
+// BVH; a voxel of the six grids and a light grid.
 constexpr double kBytesPerPixel = 96.0;
 constexpr double kBytesPerBranch = 110.0;
 constexpr double kBytesPerBough = 380.0;
@@ -162,14 +162,17 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
                            " boughs, " + count(trees.branches) + " branches)",
                        trees.branches * kBytesPerBranch + trees.boughs * kBytesPerBough});
     // Each variant is grown once, at its first tree, every other tree for itself; all are
-    // held until the boughs are made.
+    // held until the boughs are made. The reference bakes from every tree, a variant's copies
+    // moved copies of its first, and holds them all to the end (vdbtrace's methods.cpp: its
+    // TracedSceneParts keep the grown trees).
     std::vector<std::size_t> firsts;
     for (std::size_t i = 0; i < scene.trees.size(); ++i) {
         if (scene.trees[i].variantOf < 0) firsts.push_back(i);
     }
     const bool copies = firsts.size() < scene.trees.size();
     const TreeSample grown = copies ? sumTrees(scene, firsts) : trees;
-    e.parts.push_back({"grown trees", grown.boughs * kBytesPerGrownBough});
+    const TreeSample& held = method == "reference" ? trees : grown;
+    e.parts.push_back({"grown trees", held.boughs * kBytesPerGrownBough});
     const double columns = (trees.branches + trees.boughs) * kBytesPerColumnPrimitive;
     if ((method == "multiscale" || method == "reference") && scene.effects.shadows &&
         !scene.directionalLights.empty() && columns <= double(kShadowColumnsMax_bytes)) {

@@ -93,13 +93,16 @@ TEST(ResourceEstimate, EveryGrownTreeIsCounted)
         }
         return -1.0;
     };
-    for (const char* method : {"multiscale", "reference", "geometry"}) {
+    for (const std::string method : {"multiscale", "reference", "geometry"}) {
         SCOPED_TRACE(method);
         const double all = grown(estimateRender(own, method, 0.25));
-        // One tree stands for the others (OneTreePerSpeciesStandsForTheForest): 10% slack.
+        // One tree stands for the others (OneTreePerSpeciesStandsForTheForest), and the
+        // constant holds malloc's overhead besides: between 0.9 and 1.5 of the vectors.
         EXPECT_GT(all, 0.9 * held);
         EXPECT_LT(all, 1.5 * held);
-        EXPECT_NEAR(grown(estimateRender(shared, method, 0.25)) / all, 4.0 / 40.0, 0.03);
+        // The reference holds every tree, a variant's copies moved copies of its first.
+        const double withVariants = method == "reference" ? 1.0 : 4.0 / 40.0;
+        EXPECT_NEAR(grown(estimateRender(shared, method, 0.25)) / all, withVariants, 0.03);
     }
 }
 

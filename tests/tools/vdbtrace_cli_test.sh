@@ -71,14 +71,17 @@ expect_error "preview onto a folder" 2 "cannot write '.*pv.png': it is a folder"
 expect_error "level preview onto a folder" 2 "cannot write '.*lv.level.png': it is a folder" -- render "$src/scenes/bough.json" --resolution 8x6 --aov level --out "$work/lv.exr"
 [ ! -e "$work/pv.exr" ] && [ ! -e "$work/lv.exr" ] && [ ! -e "$work/lv.png" ] || fail "a refused render wrote: $(ls "$work")"
 rmdir "$work/pv.png" "$work/lv.level.png"
-# Resource bombs refused from the scene alone, before any tree is grown or pixel traced.
-# A bough of 1e12 cm bears 1e12 cones, each walked by the law: refused once the trees are
-# grown, before any pixel (it ran for hours without a progress line).
-sed 's/"segment": 6,/"segment": 1e12,/' "$src/scenes/bough.json" >"$work/long.json"
-grep -q 1e12 "$work/long.json" || fail "long.json: the segment was not changed"
-expect_error "a bough of a trillion cones" 2 "long.json: tree 0: a bough 1e+12 cm long bears 1.*e+12 cones .* more than 10000" -- render "$work/long.json" --resolution 16x12 --out "$work/long.exr"
+# Trees the tracer cannot hold, refused once they are grown, before any pixel: a bough of
+# 1e7 cm bears 1e7 cones, each walked by the law (1e12 ran for hours without a progress
+# line); a branch beyond 1e9 cm, where the tracer's float bounds end.
+sed 's/"segment": 6,/"segment": 1e7,/' "$src/scenes/bough.json" >"$work/long.json"
+grep -q 1e7 "$work/long.json" || fail "long.json: the segment was not changed"
+expect_error "a bough of ten million cones" 2 "long.json: tree 0: a bough 1e+07 cm long bears 1.*e+07 cones .* more than 10000" -- render "$work/long.json" --resolution 16x12 --out "$work/long.exr"
+sed 's/"segment": 6,/"segment": 1e12,/' "$src/scenes/bough.json" >"$work/far.json"
+expect_error "a branch beyond 1e9 cm" 2 "far.json: tree 0: a branch reaches (1e+12, 0, 30) cm, more than 1000000000 cm" -- render "$work/far.json" --resolution 16x12 --out "$work/long.exr"
 [ ! -e "$work/long.exr" ] || fail "a refused render was written"
-rm "$work/long.json"
+rm "$work/long.json" "$work/far.json"
+# Resource bombs refused from the scene alone, before any tree is grown or pixel traced.
 sed 's/"resolution": \[640, 480\]/"resolution": [16384, 16384]/' "$src/scenes/bough.json" >"$work/huge.json"
 grep -q 16384 "$work/huge.json" || fail "huge.json: the resolution was not changed"
 expect_error "huge image" 2 "image 16384 x 16384 needs about" -- render "$work/huge.json" --out "$work/a.exr" --max-memory 8

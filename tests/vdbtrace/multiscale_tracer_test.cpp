@@ -18,6 +18,8 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <string>
@@ -515,6 +517,39 @@ TEST(MultiscaleTracer, EveryShippedSceneRendersFiniteAndBounded)
         expectBounded(r.image, entry.path().filename().string());
     }
     EXPECT_GE(found, 4);
+}
+
+TEST(TracedScene, TheFirstTreeItCannotHoldIsNamed)
+{
+    // Tree 0 is bough.json's; trees 1 to 40 reach past kMaxCoordinate_cm. The trees are
+    // described in parallel: whichever thread meets one first, the error names the lowest.
+    std::ifstream in(std::string(PINE_SOURCE_DIR) + "/scenes/bough.json");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string tree = R"({"species": "branch", "position": [0, 0, 30], "seed": 1})";
+    std::string trees = tree;
+    for (int k = 1; k <= 40; ++k) {
+        trees += R"(, {"species": "branch", "position": [)" + std::to_string(k) + R"(e9, 0, 30]})";
+    }
+    const std::size_t at = text.find(tree);
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, tree.size(), trees);
+    const scenes::Scene scene = scenes::parseScene(text, "many.json");
+    ASSERT_EQ(scene.trees.size(), 41u);
+    for (int run = 0; run < 4; ++run) {
+        try {
+            (void)buildTracedScene(scene);
+            ADD_FAILURE() << "trees at 1e9 cm and more were traced";
+        } catch (const InputError& e) {
+            EXPECT_EQ(
+                std::string(e.what()).rfind("many.json: tree 1: a branch reaches (1e+09, 0, "), 0u)
+                << e.what();
+        }
+    }
+    // Within the bound, traced.
+    scenes::Scene near = scene;
+    near.trees.resize(2);
+    near.trees[1].base_cm = Vec3(kMaxCoordinate_cm - 100.0, 0.0, 30.0);
+    EXPECT_NO_THROW((void)buildTracedScene(near));
 }
 
 }  // namespace

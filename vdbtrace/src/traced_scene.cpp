@@ -352,6 +352,45 @@ std::shared_ptr<const StripProfile> TracedBough::opacityFromLight(std::size_t li
 
 namespace {
 
+// Why the tracer cannot hold a grown tree placed by `place` (its points, scene coordinates),
+// or empty: a point past kMaxCoordinate_cm (its primitives' bounds are floats), or a bough
+// of more than kMaxConesPerBough cones.
+template <class Place>
+std::string whyUntraceable(const scenes::Tree& tree, const std::vector<bake::BoughSpec>& boughs,
+                           const Place& place)
+{
+    char text[240];
+    for (const scenes::Segment& s : tree.segments) {
+        for (const Vec3& p : {place(s.base_cm), place(s.tip_cm)}) {
+            const double far = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+            if (!(far <= kMaxCoordinate_cm)) {
+                std::snprintf(text, sizeof text,
+                              "a branch reaches (%.3g, %.3g, %.3g) cm, more than %.0f cm from "
+                              "the origin along an axis (its placement, height or species)",
+                              p.x, p.y, p.z, kMaxCoordinate_cm);
+                return text;
+            }
+        }
+    }
+    for (const bake::BoughSpec& b : boughs) {
+        const double length = glm::length(b.tip_cm - b.base_cm);
+        const double dh = b.needles.coneSpacing_cm;
+        if (!(length / dh <= kMaxConesPerBough)) {
+            const double cones = length / dh;
+            std::snprintf(text, sizeof text,
+                          cones < 1e6 ? "a bough %.4g cm long bears %.0f cones %.3g cm apart, "
+                                        "more than %.0f (its species' lsystem.segment, "
+                                        "length_decay or cone_spacing, or the tree's height)"
+                                      : "a bough %.4g cm long bears %.3g cones %.3g cm apart, "
+                                        "more than %.0f (its species' lsystem.segment, "
+                                        "length_decay or cone_spacing, or the tree's height)",
+                          length, cones, dh, kMaxConesPerBough);
+            return text;
+        }
+    }
+    return {};
+}
+
 // `evaluated`: the bough gets its law evaluation (else view() throws).
 TracedBough makeTracedBough(const BoughDescription& d,
                             const std::shared_ptr<const BoughLawContext>& context, bool evaluated)
@@ -584,24 +623,15 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     // Each tree's boughs described in parallel, then made in place, tree by tree, in the
     // trees' order (the primitive indices do not depend on the threads).
     std::vector<std::vector<BoughDescription>> described(out.trees.size());
+    std::vector<std::string> untraceable(out.trees.size());  // per tree: why, or empty
     tbb::parallel_for(std::size_t(0), out.trees.size(), [&](std::size_t i) {
         const scenes::Tree& tree = grown(i);
         const auto place = placed(i);
         const scenes::Species& species = *tree.species;
         const std::vector<bake::BoughSpec> specs = bake::treeBoughs(tree);
-        for (std::size_t j = 0; j < specs.size(); ++j) {
-            const double length = glm::length(specs[j].tip_cm - specs[j].base_cm);
-            if (!(length > 0.0)) continue;
-            const double dh = specs[j].needles.coneSpacing_cm;
-            if (!(length / dh <= kMaxConesPerBough)) {
-                char text[200];
-                std::snprintf(text, sizeof text,
-                              ": tree %zu: a bough %.3g cm long bears %.3g cones %.3g cm apart, "
-                              "more than %.0f (its species' lsystem.segment, length_decay or "
-                              "cone_spacing)",
-                              i, length, length / dh, dh, kMaxConesPerBough);
-                throw InputError(scene.source.string() + text);
-            }
+        untraceable[i] = whyUntraceable(tree, specs, place);
+        for (std::size_t j = 0; j < specs.size() && untraceable[i].empty(); ++j) {
+            if (!(glm::length(specs[j].tip_cm - specs[j].base_cm) > 0.0)) continue;
             BoughDescription d;
             d.spec = specs[j];
             d.spec.base_cm = place(d.spec.base_cm);
@@ -615,6 +645,13 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
             described[i].push_back(d);
         }
     });
+    // The first tree that cannot be traced, whichever thread found it.
+    for (std::size_t i = 0; i < out.trees.size(); ++i) {
+        if (!untraceable[i].empty()) {
+            throw InputError(scene.source.string() + ": tree " + std::to_string(i) + ": " +
+                             untraceable[i]);
+        }
+    }
     std::vector<std::size_t> firstBough(out.trees.size() + 1, 0);
     std::vector<std::size_t> firstBranch(out.trees.size() + 1, 0);
     for (std::size_t i = 0; i < out.trees.size(); ++i) {

@@ -91,13 +91,17 @@ private:
     mutable std::atomic<BoughLawEvaluation*> mEvaluation{nullptr};
 };
 
-/// What the scene says of one bough: what makeTracedBough prepares.
 /// The most cones one bough may bear (90 m of bough at the paper's spacing of 0.9 cm; a fir's
 /// boughs bear 10 to 300): every walk through a bough (the law's chords, levels 1-2, the
-/// self-shadowing) steps cone by cone, so a longer one runs for hours. Refused when the
-/// scene is traced, before any pixel.
+/// self-shadowing) steps cone by cone, so a longer one runs for hours. A tree that has one
+/// is refused when the scene is traced, before any pixel.
 inline constexpr double kMaxConesPerBough = 1e4;
+/// The farthest a tree's point may lie from the origin along any axis (10,000 km): the
+/// tracer's bounds (the BVH's, the shadow columns', Embree's) are floats, and a scatter's
+/// trees at 1e307 cm lose their boughs' lengths to rounding besides.
+inline constexpr double kMaxCoordinate_cm = 1e9;
 
+/// What the scene says of one bough: what makeTracedBough prepares.
 struct BoughDescription {
     bake::BoughSpec spec;  ///< branch, needle parameters, albedo: what bake voxelizes too
     double specularWeight = 0.0;
