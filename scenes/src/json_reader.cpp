@@ -39,8 +39,8 @@ const char* typeName(const Json& v)
 
 void Where::fail(const std::string& problem) const
 {
-    throw SceneError(printable(*file + ": " + (path.empty() ? std::string("(top level)") : path) +
-                               ": " + problem));
+    throw SceneError(*file + ": " + (path.empty() ? std::string("(top level)") : path) + ": " +
+                     problem);
 }
 
 bool Range::contains(double x) const

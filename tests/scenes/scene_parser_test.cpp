@@ -610,6 +610,13 @@ TEST(SceneParser, RejectsBadLSystems)
     j["species"]["fir"]["lsystem"]["rules"]["B\n\x1b"] = "F";
     message = expectError(j, "species.fir.lsystem.rules.B\\x0a\\x1b", "one letter");
     EXPECT_EQ(message.find('\x1b'), std::string::npos) << message;
+    // Every scene error, not only a key's: the JSON reader's duplicate key.
+    const std::string nul = std::string("a\0b", 3);
+    message = errorOfText("{\"name\": \"x\", \"" + std::string("a\\u0000b") + "\": 1, \"" +
+                              std::string("a\\u0000b") + "\": 2}",
+                          "test.json");
+    EXPECT_NE(message.find("a\\x00b"), std::string::npos) << message;
+    EXPECT_EQ(message.find(nul), std::string::npos);
 }
 
 TEST(LSystem, ExpandedCountCountsWhatExpandingWouldHold)

@@ -296,6 +296,15 @@ PY
 expect_error "unknown bough law" 2 "law.json: render.bough_law: unknown bough law 'quadratic' (known: exact, linear, corrected)" \
     -- render "$work/law.json" --out "$work/q.exr"
 [ ! -e "$work/q.exr" ] || fail "a refused scene wrote an image"
+# A NUL in the name is shown, not where the message ends.
+/usr/bin/python3 - "$src/scenes/bough.json" "$work/law.json" <<'PY'
+import json, sys
+scene = json.load(open(sys.argv[1]))
+scene.setdefault("render", {})["bough_law"] = "x\u0000y"
+json.dump(scene, open(sys.argv[2], "w"))
+PY
+expect_error "a NUL in a law's name" 2 "unknown bough law 'x\\\\x00y' (known: exact" \
+    -- render "$work/law.json" --out "$work/q.exr"
 
 # The reference method reads what bake wrote, and refuses a damaged file with one line.
 bake="$(dirname "$vdbtrace")/bake"

@@ -23,9 +23,11 @@ using Vec2 = glm::dvec2;
 
 /// A scene file that cannot be used: the message is one line naming file, key and, where the
 /// parser gives it, line:column ("scenes/x.json:12:7: camera.fov_deg: must be in (0, 180)").
+/// Its bytes that are not text (a key's newline, a string's NUL) are shown as \\xNN
+/// (pine::printable): a NUL passed through what() would end the message there.
 class SceneError : public InputError {
 public:
-    using InputError::InputError;
+    explicit SceneError(const std::string& message) : InputError(printable(message)) {}
 };
 
 /// The most a light's colour times its irradiance (or intensity) may be, and the background's

@@ -16,7 +16,8 @@ public:
 
 /// `text` as an error line may show it: each control byte as \xNN (a NUL would end the
 /// message there, a newline split its line, an escape sequence drive the terminal), and with
-/// `asciiOnly` each byte of a multi-byte character too (one byte of it alone is not text).
+/// `asciiOnly` each byte of a multi-byte character too (one byte of it alone is not text). A
+/// backslash stays as it is: the text "\\x0a" and a newline read the same.
 inline std::string printable(std::string_view text, bool asciiOnly = false)
 {
     static constexpr char kHex[] = "0123456789abcdef";

@@ -31,7 +31,7 @@ public:
         }
         std::string known;
         for (const Entry& e : mEntries) known += (known.empty() ? "" : ", ") + e.name;
-        throw InputError("unknown " + mKind + " '" + name + "' (known: " + known + ")");
+        throw InputError("unknown " + mKind + " '" + printable(name) + "' (known: " + known + ")");
     }
 
     /// The names, in registration order (the first is the default).
