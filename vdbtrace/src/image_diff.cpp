@@ -13,7 +13,7 @@ void ramp(double v, float* rgb)
 {
     static const float stops[5][3] = {
         {0, 0, 0}, {0.1f, 0.2f, 1}, {0.1f, 0.8f, 0.2f}, {1, 0.9f, 0.1f}, {1, 1, 1}};
-    v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) * 4.0 : 0.0;  // int(NaN) is undefined
+    v = std::isnan(v) ? 0.0 : std::clamp(v, 0.0, 1.0) * 4.0;  // int(NaN) is undefined
     const int i = std::min(3, int(v));
     const double f = v - i;
     for (int c = 0; c < 3; ++c) rgb[c] = float((1 - f) * stops[i][c] + f * stops[i + 1][c]);

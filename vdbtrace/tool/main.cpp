@@ -393,8 +393,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     if (animation) {
         if (leader) {
             toRender = vdbtrace::framesLeft(*frameRange, [&](int f) {
+                std::error_code error;
                 return frameComplete(exrOf(f), job) &&
-                       (statsFile.empty() || fs::is_regular_file(statsOf(f)));
+                       (statsFile.empty() || fs::is_regular_file(statsOf(f), error));
             });
         }
         vdbtrace::Bytes list(toRender.size() * sizeof(int));
@@ -1171,6 +1172,8 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
         vdbtrace::compareImages(image, reference, a.string(), b.string());
     io::checkWritableFolder(outDir);
     io::checkWritable(outDir / "error.exr");
+    io::checkWritableName(outDir / "error.png");
+    io::checkWritableName(outDir / "errors.json");
     const double shown = scale > 0.0 ? scale : std::max(errors.maxAbsolute, 1e-12);
     vdbtrace::writeExr(errors.error, outDir / "error.exr",
                        {{"pine:image", a.string()}, {"pine:reference", b.string()}});
