@@ -6,6 +6,7 @@
 #include "pine/vdbtrace/error_budget.h"
 #include "pine/vdbtrace/flicker.h"
 #include "pine/vdbtrace/image.h"
+#include "pine/vdbtrace/integer_list.h"
 #include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -463,6 +464,7 @@ TEST(CompareRun, ParsesResolution)
     EXPECT_FALSE(parseIntegers("0,0,4,4,", ',', crop));
     EXPECT_FALSE(parseIntegers("0,0,4", ',', crop));
     EXPECT_FALSE(parseIntegers("0,,4,4", ',', crop));
+    EXPECT_FALSE(parseIntegers("0,-1,4,4", ',', crop, /*negative=*/false));
 }
 
 Image constantFrame(float value)

@@ -5,26 +5,12 @@
 #include "pine/vdbtrace/compare_report.h"
 #include "pine/vdbtrace/dolly.h"
 #include "pine/vdbtrace/image.h"
+#include "pine/vdbtrace/integer_list.h"
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
-#include <cstdio>
 
 namespace pine::vdbtrace {
-
-bool parseIntegers(std::string_view text, char separator, std::span<int> values)
-{
-    const char* at = text.data();
-    const char* const end = text.data() + text.size();
-    for (std::size_t k = 0; k < values.size(); ++k) {
-        if (k > 0 && (at == end || *at++ != separator)) return false;
-        const auto [next, error] = std::from_chars(at, end, values[k]);
-        if (error != std::errc() || next == at) return false;
-        at = next;
-    }
-    return at == end;
-}
 
 bool parseResolution(const std::string& text, int& width, int& height)
 {

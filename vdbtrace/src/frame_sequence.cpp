@@ -2,30 +2,27 @@
 
 #include "pine/scenes/camera.h"
 #include "pine/support/input_error.h"
+#include "pine/vdbtrace/integer_list.h"
 
-#include <charconv>
 #include <cstdio>
+#include <span>
 #include <string>
-#include <system_error>
 
 namespace pine::vdbtrace {
 
 FrameRange parseFrameRange(const std::string& text)
 {
     // Digits, then optionally '-' and digits: nothing else (no sign, space or tail).
-    const auto number = [](const char*& at, const char* end, int& value) {
-        if (at == end || *at < '0' || *at > '9') return false;
-        const auto [next, error] = std::from_chars(at, end, value);
-        at = next;
-        return error == std::errc();
-    };
     FrameRange r;
-    const char* at = text.data();
-    const char* end = at + text.size();
-    bool ok = number(at, end, r.first);
-    r.last = r.first;
-    if (ok && at != end) ok = *at++ == '-' && number(at, end, r.last);
-    ok = ok && at == end && r.last >= r.first && r.last <= 9999999;
+    int range[2];
+    bool ok = parseIntegers(text, '-', range, /*negative=*/false);
+    if (ok) {
+        r = {range[0], range[1]};
+    } else {
+        ok = parseIntegers(text, '-', std::span<int>(range, 1), false);
+        r = {range[0], range[0]};
+    }
+    ok = ok && r.last >= r.first && r.last <= 9999999;
     if (!ok) {
         throw InputError("--frames '" + text + "': expected A-B (0 <= A <= B) or one frame A");
     }

@@ -21,6 +21,7 @@
 #include "pine/vdbtrace/geometry_tracer.h"
 #include "pine/vdbtrace/image.h"
 #include "pine/vdbtrace/image_diff.h"
+#include "pine/vdbtrace/integer_list.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/multiscale_tracer.h"

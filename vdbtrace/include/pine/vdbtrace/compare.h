@@ -6,9 +6,7 @@
 
 #include <filesystem>
 #include <functional>
-#include <span>
 #include <string>
-#include <string_view>
 
 namespace pine::vdbtrace {
 
@@ -41,10 +39,5 @@ CompareRun runCompare(const CompareOptions& options);
 
 /// "WxH" -> width, height (both in [1, 16384], as a scene's camera); false if malformed.
 bool parseResolution(const std::string& text, int& width, int& height);
-
-/// The whole of `text` as values.size() integers joined by `separator` ("640x480", "0,0,8,8"),
-/// each a plain decimal that an int holds (a sign only as '-'): false otherwise. sscanf's %d
-/// read 4294967328 as 32.
-bool parseIntegers(std::string_view text, char separator, std::span<int> values);
 
 }  // namespace pine::vdbtrace
