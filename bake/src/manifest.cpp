@@ -84,10 +84,8 @@ namespace {
 // A file to read whole: a folder or a device (/dev/zero) is named as such, not as missing.
 void requireRegularFile(const fs::path& file)
 {
-    std::error_code error;
-    if (!fs::exists(file, error)) throw BakeError("'" + file.string() + "': no such file");
-    if (!fs::is_regular_file(file, error)) {
-        throw BakeError("'" + file.string() + "': not a regular file");
+    if (const std::string why = io::whyUnreadable(file); !why.empty()) {
+        throw BakeError("'" + file.string() + "': " + why);
     }
 }
 

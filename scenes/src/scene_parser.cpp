@@ -2,6 +2,8 @@
 // render). Keys, units, defaults and valid ranges: docs/scene-format.md.
 #include "scene_sections.h"
 
+#include "pine/support/atomic_file.h"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -295,12 +297,8 @@ Scene parseScene(const std::string& json, const std::filesystem::path& name)
 
 Scene loadScene(const std::filesystem::path& file)
 {
-    std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) {
-        throw SceneError(file.string() + ": cannot open: no such file");
-    }
-    if (!std::filesystem::is_regular_file(file, ec)) {
-        throw SceneError(file.string() + ": cannot open: not a regular file");
+    if (const std::string why = io::whyUnreadable(file); !why.empty()) {
+        throw SceneError(file.string() + ": cannot open: " + why);
     }
     std::ifstream in(file, std::ios::binary);
     if (!in) throw SceneError(file.string() + ": cannot open: permission denied or unreadable");

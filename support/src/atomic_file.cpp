@@ -150,6 +150,16 @@ std::string probeFolder(const fs::path& folder, const fs::path& beside)
 
 }  // namespace
 
+std::string whyUnreadable(const fs::path& file)
+{
+    std::error_code error;
+    const fs::file_status status = fs::status(file, error);
+    if (status.type() == fs::file_type::not_found) return "no such file";
+    if (error) return "cannot reach it: " + error.message();
+    if (!fs::is_regular_file(status)) return "not a regular file";
+    return {};
+}
+
 void checkWritableName(const fs::path& file)
 {
     const auto refuse = [&](const std::string& why) {

@@ -71,6 +71,23 @@ TEST(AtomicFile, CheckWritableRejectsMissingFolderAndAcceptsAWritableOne)
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"plain.txt"}) << "the probe is removed";
 }
 
+TEST(AtomicFile, WhyUnreadableTellsAMissingFileFromOneThatIsNoFile)
+{
+    // A device or a folder is not "missing" (bake verify /dev/zero said so), nor a loop of
+    // links (the system's reason, not "no such file").
+    const test::TempDir dir;
+    dir.write("plain.txt", "text");
+    EXPECT_EQ(whyUnreadable(dir.path() / "plain.txt"), "");
+    EXPECT_EQ(whyUnreadable(dir.path() / "missing.json"), "no such file");
+    EXPECT_EQ(whyUnreadable(dir.path()), "not a regular file");
+    EXPECT_EQ(whyUnreadable("/dev/null"), "not a regular file");
+    fs::create_symlink(dir.path() / "loop", dir.path() / "loop");
+    EXPECT_EQ(whyUnreadable(dir.path() / "loop").rfind("cannot reach it: ", 0), 0u)
+        << whyUnreadable(dir.path() / "loop");
+    fs::create_symlink(dir.path() / "plain.txt", dir.path() / "link");
+    EXPECT_EQ(whyUnreadable(dir.path() / "link"), "");
+}
+
 TEST(AtomicFile, CheckWritableFolderCreatesItOrSaysWhyNot)
 {
     const test::TempDir dir;

@@ -52,6 +52,11 @@ void writeTextAtomically(const std::filesystem::path& file, const std::string& t
 /// guessed from permission bits: read-only mounts, ACLs and root all differ).
 void checkWritable(const std::filesystem::path& file);
 
+/// Why `file` cannot be read whole as a file, or empty: "no such file", "not a regular file"
+/// (a folder, a device such as /dev/zero) or "cannot reach it: ..." (a folder without search
+/// permission, a loop of links). For each reader to word and throw as its own error.
+std::string whyUnreadable(const std::filesystem::path& file);
+
 /// checkWritable without trying its folder: for the many files of one folder (an animation's
 /// frames) once checkWritable has tried it with one of them.
 void checkWritableName(const std::filesystem::path& file);
