@@ -30,6 +30,12 @@ std::string temporaryPrefix(const fs::path& file)
     return name;
 }
 
+// The user's error about an output: "cannot write 'FILE': WHY".
+InputError cannotWrite(const fs::path& file, const std::string& why)
+{
+    return InputError("cannot write '" + file.string() + "': " + why);
+}
+
 }  // namespace
 
 fs::path folderOf(const fs::path& file)
@@ -72,7 +78,7 @@ void writeAtomically(const fs::path& file, const std::function<void(const fs::pa
     std::error_code ignored;
     const auto refuse = [&](const std::string& why) {
         fs::remove(tmp, ignored);
-        return InputError("cannot write '" + file.string() + "': " + why);
+        return cannotWrite(file, why);
     };
     // What a step throws becomes the user's error about this file, the temporary removed;
     // running out of memory (not the output's fault), non-standard exceptions and what
@@ -162,9 +168,7 @@ std::string whyUnreadable(const fs::path& file)
 
 void checkWritableName(const fs::path& file)
 {
-    const auto refuse = [&](const std::string& why) {
-        return InputError("cannot write '" + file.string() + "': " + why);
-    };
+    const auto refuse = [&](const std::string& why) { return cannotWrite(file, why); };
     if (file.empty() || !file.has_filename()) throw refuse("no file name");
     std::error_code error;
     if (fs::is_directory(file, error)) throw refuse("it is a folder");
@@ -179,7 +183,7 @@ void checkWritable(const fs::path& file)
     checkWritableName(file);
     const fs::path folder = folderOf(file);
     if (const std::string why = probeFolder(folder, file); !why.empty()) {
-        throw InputError("cannot write '" + file.string() + "': " + why);
+        throw cannotWrite(file, why);
     }
 }
 
@@ -208,8 +212,8 @@ void checkOutputsApart(const std::vector<fs::path>& outputs, const std::vector<f
         if (outputs[i].empty()) continue;
         for (const fs::path& in : inputs) {
             if (!in.empty() && sameFile(outputs[i], in)) {
-                throw InputError("cannot write '" + outputs[i].string() +
-                                 "': it is also an input of this run ('" + in.string() + "')");
+                throw cannotWrite(outputs[i],
+                                  "it is also an input of this run ('" + in.string() + "')");
             }
         }
         for (std::size_t j = 0; j < i; ++j) {
