@@ -375,16 +375,15 @@ std::string whyUntraceable(const scenes::Tree& tree, const std::vector<bake::Bou
     for (const bake::BoughSpec& b : boughs) {
         const double length = glm::length(b.tip_cm - b.base_cm);
         const double dh = b.needles.coneSpacing_cm;
-        if (!(length / dh <= kMaxConesPerBough)) {
-            const double cones = length / dh;
+        const double cones = length / dh;
+        if (!(cones <= kMaxConesPerBough)) {
+            char counted[32];  // whole below a million, then as 1.2e+07
+            std::snprintf(counted, sizeof counted, cones < 1e6 ? "%.0f" : "%.3g", cones);
             std::snprintf(text, sizeof text,
-                          cones < 1e6 ? "a bough %.4g cm long bears %.0f cones %.3g cm apart, "
-                                        "more than %.0f (its species' lsystem.segment, "
-                                        "length_decay or cone_spacing, or the tree's height)"
-                                      : "a bough %.4g cm long bears %.3g cones %.3g cm apart, "
-                                        "more than %.0f (its species' lsystem.segment, "
-                                        "length_decay or cone_spacing, or the tree's height)",
-                          length, cones, dh, kMaxConesPerBough);
+                          "a bough %.4g cm long bears %s cones %.3g cm apart, more than %.0f (its "
+                          "species' lsystem.segment, length_decay or cone_spacing, or the tree's "
+                          "height)",
+                          length, counted, dh, kMaxConesPerBough);
             return text;
         }
     }
