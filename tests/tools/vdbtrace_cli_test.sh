@@ -292,22 +292,21 @@ grep -q '"layer_correlation": "independent"' "$work/p.json" || fail "--paper did
 "$vdbtrace" render "$src/scenes/bough.json" --paper --layer-model fibre --out "$work/p.exr" --stats "$work/p.json" 2>/dev/null \
     || fail "render --paper --layer-model fibre failed"
 grep -q '"layer_model": "fibre"' "$work/p.json" || fail "--layer-model did not override --paper"
-/usr/bin/python3 - "$src/scenes/bough.json" "$work/law.json" <<'PY'
+# bough.json with render.bough_law as the JSON string $1 (escapes and all), as law.json.
+law_scene() {
+    /usr/bin/python3 - "$src/scenes/bough.json" "$work/law.json" "$1" <<'PY'
 import json, sys
 scene = json.load(open(sys.argv[1]))
-scene.setdefault("render", {})["bough_law"] = "quadratic"
+scene.setdefault("render", {})["bough_law"] = json.loads('"' + sys.argv[3] + '"')
 json.dump(scene, open(sys.argv[2], "w"))
 PY
+}
+law_scene quadratic
 expect_error "unknown bough law" 2 "law.json: render.bough_law: unknown bough law 'quadratic' (known: exact, linear, corrected)" \
     -- render "$work/law.json" --out "$work/q.exr"
 [ ! -e "$work/q.exr" ] || fail "a refused scene wrote an image"
 # A NUL in the name is shown, not where the message ends.
-/usr/bin/python3 - "$src/scenes/bough.json" "$work/law.json" <<'PY'
-import json, sys
-scene = json.load(open(sys.argv[1]))
-scene.setdefault("render", {})["bough_law"] = "x\u0000y"
-json.dump(scene, open(sys.argv[2], "w"))
-PY
+law_scene 'x\u0000y'
 expect_error "a NUL in a law's name" 2 "unknown bough law 'x\\\\x00y' (known: exact" \
     -- render "$work/law.json" --out "$work/q.exr"
 
