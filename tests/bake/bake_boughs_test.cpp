@@ -244,6 +244,12 @@ TEST(BakeBoughs, RejectsWhatItCannotBake)
     BoughSpec bad = b;
     bad.needles.cone.aperture_rad = 2.0;
     EXPECT_THROW(bakeBoughs({b, bad}, BakeSettings{0.5, 1, "layer"}), BakeError);
+    // Named by its index, without the tool's own prefix (bake printed "bake: bake: bough 1").
+    try {
+        (void)bakeBoughs({b, bad}, BakeSettings{0.5, 1, "layer"});
+    } catch (const BakeError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("baking bough 1: ", 0), 0u) << e.what();
+    }
     bad = b;
     bad.tip_cm.x = INFINITY;
     EXPECT_THROW(bakeBoughs({bad}, BakeSettings{0.5, 1, "layer"}), BakeError);
