@@ -357,9 +357,10 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         inputs.push_back(g);
         inputs.push_back(g.string() + ".json");
     }
-    io::checkOutputsApart({first, besideWith(first, ".png"),
-                           levelPng ? besideWith(first, ".level.png") : fs::path(), firstStats},
-                          inputs);
+    std::vector<fs::path> firstFiles = previewsOf(first);
+    firstFiles.insert(firstFiles.begin(), first);
+    firstFiles.push_back(firstStats);
+    io::checkOutputsApart(firstFiles, inputs);
     if (animation) {  // every frame's files, not only the first's
         std::set<std::string> images, stats;
         for (int f = frameRange->first + 1; f <= frameRange->last; ++f) {
