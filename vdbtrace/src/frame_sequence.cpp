@@ -13,15 +13,10 @@ namespace pine::vdbtrace {
 FrameRange parseFrameRange(const std::string& text)
 {
     // Digits, then optionally '-' and digits: nothing else (no sign, space or tail).
-    FrameRange r;
+    const std::size_t numbers = text.find('-') == std::string::npos ? 1 : 2;
     int range[2];
-    bool ok = parseIntegers(text, '-', range, /*negative=*/false);
-    if (ok) {
-        r = {range[0], range[1]};
-    } else {
-        ok = parseIntegers(text, '-', std::span<int>(range, 1), false);
-        r = {range[0], range[0]};
-    }
+    bool ok = parseIntegers(text, '-', std::span<int>(range, numbers), /*negative=*/false);
+    const FrameRange r{range[0], range[numbers - 1]};
     ok = ok && r.last >= r.first && r.last <= 9999999;
     if (!ok) {
         throw InputError("--frames '" + text + "': expected A-B (0 <= A <= B) or one frame A");
