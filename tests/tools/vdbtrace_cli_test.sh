@@ -287,6 +287,14 @@ grep -q '"shadow_origin": "axis"' "$work/p.json" || fail "--paper did not choose
 grep -q '"shadow_origin": "needles"' "$work/b.json" || fail "default shadow origin not recorded as needles"
 grep -q '"level_blend": 1.5' "$work/b.json" || fail "default level blend not recorded as 1.5"
 grep -q '"level_blend": 1.0' "$work/p.json" || fail "--paper did not turn the level blend off"
+# Thresholds moved closer on the command line narrow the scene's band to what keeps the two
+# bands apart (recorded as drawn); a band given beside them that is too wide is refused.
+"$vdbtrace" render "$src/scenes/bough.json" --cone-level-max 0.3 --resolution 16x12 --out "$work/n.exr" \
+    --stats "$work/n.json" 2>"$work/err" || fail "render --cone-level-max 0.3 failed: $(tail -1 "$work/err")"
+/usr/bin/python3 -c 'import json, math, sys; b = json.load(open(sys.argv[1]))["level_blend"]; sys.exit(abs(b - math.sqrt(0.3 / 0.25)) > 1e-12)' \
+    "$work/n.json" || fail "--cone-level-max 0.3 did not record the narrowed band: $(grep level_blend "$work/n.json")"
+expect_error "a band too wide for the thresholds" 2 "--level-blend 2 must be at most sqrt(cone_level_max / needle_level_max) (1.09545) for cone_level_max 0.3" -- \
+    render "$src/scenes/bough.json" --level-blend 2 --cone-level-max 0.3 --out "$work/n2.exr"
 grep -q '"layer_correlation": "needles"' "$work/b.json" || fail "default layer correlation not recorded as needles"
 grep -q '"layer_correlation": "independent"' "$work/p.json" || fail "--paper did not make the layers independent"
 "$vdbtrace" render "$src/scenes/bough.json" --paper --layer-model fibre --out "$work/p.exr" --stats "$work/p.json" 2>/dev/null \

@@ -115,11 +115,11 @@ void checkEffects(const scenes::Effects& effects)
 }
 
 scenes::Scene loadComparedScene(const std::filesystem::path& file,
-                                const std::function<void(scenes::ModelChoices&)>& model,
+                                const std::function<void(scenes::RenderSettings&)>& model,
                                 bool addSelfShadowing, int width, int height)
 {
     scenes::Scene scene = scenes::loadScene(file);
-    if (model) model(scene.render.model);
+    if (model) model(scene.render);
     if (addSelfShadowing) scene.effects.selfShadowing |= scene.effects.shadows;
     checkEffects(scene.effects);
     if (width > 0 && height > 0) {

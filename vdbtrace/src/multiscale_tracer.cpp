@@ -664,8 +664,8 @@ LevelBlend blendLevels(double footprint_cm, double coneSpacing_cm,
     const double q = footprint_cm / coneSpacing_cm;
     const Level level = chooseLevel(footprint_cm, coneSpacing_cm, s);
     LevelBlend out{level, level, 0.0};
-    // Never wider than keeps the two bands apart (a command line's value is not checked
-    // against the scene's thresholds).
+    // Never wider than keeps the two bands apart (the scene parser and the tool refuse or
+    // narrow a wider one; this guards a scene built in code).
     const double coneLevelMax = s.model.coneLevelMax;
     const double band = std::min(s.model.levelBlend, std::sqrt(coneLevelMax / s.needleLevelMax));
     if (!(band > 1.0)) return out;

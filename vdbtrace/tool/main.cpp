@@ -115,17 +115,43 @@ struct ModelOverrides {
                        "spacing q on, level 2 below; the paper's 1 (render.cone_level_max)")
             ->check(tool::positiveNumber());
     }
-    void apply(scenes::ModelChoices& model) const
+    /// The overrides applied to `render`'s models, then checked against its thresholds as the
+    /// scene parser checks the scene's keys. @throw InputError
+    void apply(scenes::RenderSettings& render) const
     {
-        if (paper) model = scenes::ModelChoices::paper();
-        if (!boughLaw.empty()) model.boughLaw = boughLaw;
-        if (!layerModel.empty()) model.layerModel = layerModel;
-        if (!extinctionLaw.empty()) model.extinctionLaw = extinctionLaw;
-        if (!shadowOrigin.empty()) model.shadowOrigin = shadowOrigin;
-        if (levelBlend > 0.0) model.levelBlend = levelBlend;
-        if (!bark.empty()) model.bark = bark;
-        if (!layerCorrelation.empty()) model.layerCorrelation = layerCorrelation;
-        if (coneLevelMax > 0.0) model.coneLevelMax = coneLevelMax;
+        scenes::ModelChoices& m = render.model;
+        if (paper) m = scenes::ModelChoices::paper();
+        if (!boughLaw.empty()) m.boughLaw = boughLaw;
+        if (!layerModel.empty()) m.layerModel = layerModel;
+        if (!extinctionLaw.empty()) m.extinctionLaw = extinctionLaw;
+        if (!shadowOrigin.empty()) m.shadowOrigin = shadowOrigin;
+        if (levelBlend > 0.0) m.levelBlend = levelBlend;
+        if (!bark.empty()) m.bark = bark;
+        if (!layerCorrelation.empty()) m.layerCorrelation = layerCorrelation;
+        if (coneLevelMax > 0.0) m.coneLevelMax = coneLevelMax;
+        if (!(m.coneLevelMax > render.needleLevelMax)) {
+            std::ostringstream message;
+            message << "cone_level_max " << m.coneLevelMax
+                    << " (from --cone-level-max or --paper) must exceed the scene's "
+                       "needle_level_max ("
+                    << render.needleLevelMax << ")";
+            throw InputError(message.str());
+        }
+        // The two bands must not overlap: a band given here too wide for the thresholds is
+        // refused, and the scene's (or the default) narrowed to what thresholds moved closer
+        // allow, so that the header records the band drawn.
+        const double widest = std::sqrt(m.coneLevelMax / render.needleLevelMax);
+        if (m.levelBlend > widest) {
+            if (levelBlend > 0.0) {
+                std::ostringstream message;
+                message << "--level-blend " << levelBlend
+                        << " must be at most sqrt(cone_level_max / needle_level_max) (" << widest
+                        << ") for cone_level_max " << m.coneLevelMax << " and needle_level_max "
+                        << render.needleLevelMax;
+                throw InputError(message.str());
+            }
+            m.levelBlend = widest;
+        }
     }
 };
 
@@ -143,15 +169,7 @@ std::unique_ptr<Loaded> load(const fs::path& file, const ModelOverrides& model,
 {
     auto loaded = std::make_unique<Loaded>();
     loaded->scene = scenes::loadScene(file);
-    model.apply(loaded->scene.render.model);
-    const scenes::RenderSettings& render = loaded->scene.render;
-    if (!(render.model.coneLevelMax > render.needleLevelMax)) {
-        std::ostringstream message;
-        message << "cone_level_max " << render.model.coneLevelMax
-                << " (from --cone-level-max or --paper) must exceed the scene's needle_level_max ("
-                << render.needleLevelMax << ")";
-        throw InputError(message.str());
-    }
+    model.apply(loaded->scene.render);
     if (adjust) adjust(loaded->scene);
     if (check) check(loaded->scene);
     loaded->traced = vdbtrace::buildTracedScene(loaded->scene, parts);
@@ -856,7 +874,7 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
     }
     const double startupCpu = io::processCpuSeconds();
     scenes::Scene scene = scenes::loadScene(sceneFile);
-    model.apply(scene.render.model);
+    model.apply(scene.render);
     if (width > 0) {  // --resolution: the same view, its vertical field kept
         scene.camera.width = width;
         scene.camera.height = height;
@@ -997,7 +1015,7 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
     const vdbtrace::GrowthAxis axis = vdbtrace::growthAxis(axisName);
     // Validates the document the steps are grown from; its models describe the run.
     scenes::Scene asIs = scenes::loadScene(sceneFile);
-    model.apply(asIs.render.model);
+    model.apply(asIs.render);
     std::ifstream in(sceneFile);
     nlohmann::json document = nlohmann::json::parse(in, nullptr, true, true);
     if (width > 0) document["camera"]["resolution"] = {width, height};  // --resolution
@@ -1051,7 +1069,7 @@ int benchGrowth(const fs::path& sceneFile, const std::string& axisName, int step
         io::writeTextAtomically(stepFile, grown[std::size_t(k)].dump(1) + "\n");
         scenes::Scene& scene = stepScenes[std::size_t(k)];
         scene.source = stepFile;
-        model.apply(scene.render.model);
+        model.apply(scene.render);
         scale.push_back(f);
         for (const std::string& method : methods) {
             vdbtrace::MethodSettings settings;
@@ -1546,7 +1564,7 @@ int main(int argc, char** argv)
             }
             animate.maxMemoryBytes = bake::memoryLimit(maxMemoryGiB);
             animate.machine = machineDescription();
-            animate.model = [&model](scenes::ModelChoices& m) { model.apply(m); };
+            animate.model = [&model](scenes::RenderSettings& r) { model.apply(r); };
             animate.log = [](const std::string& line) {
                 tool::info() << "vdbtrace animate-compare: " << line << '\n';
             };
@@ -1566,7 +1584,7 @@ int main(int argc, char** argv)
             compare.settings.budget = !noBudget;
             compare.maxMemoryBytes = bake::memoryLimit(maxMemoryGiB);
             compare.machine = machineDescription();
-            compare.model = [&model](scenes::ModelChoices& m) { model.apply(m); };
+            compare.model = [&model](scenes::RenderSettings& r) { model.apply(r); };
             compare.log = [](const std::string& line) {
                 tool::info() << "vdbtrace compare: " << line << '\n';
             };

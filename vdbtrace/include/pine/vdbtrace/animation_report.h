@@ -22,7 +22,7 @@ struct AnimationCompareOptions {
     /// Adds "self_shadowing" where the scene's effects name "shadows" (as compare: the
     /// explicit needles always self-shadow, checkEffects).
     bool addSelfShadowing = false;
-    std::function<void(scenes::ModelChoices&)> model;  ///< the command line's overrides
+    std::function<void(scenes::RenderSettings&)> model;  ///< the command line's overrides
     double maxMemoryBytes = 0.0;  ///< refuse, before any work, a run estimated to need more
     std::string machine = "unknown machine";
     CompareLog log;

@@ -14,8 +14,8 @@ struct CompareOptions {
     std::filesystem::path sceneFile;
     std::filesystem::path outDir;
     CompareSettings settings;
-    /// Adjusts the scene's model choices after it is read (the command line's overrides).
-    std::function<void(scenes::ModelChoices&)> model;
+    /// Adjusts the scene's render settings after it is read (the command line's model overrides).
+    std::function<void(scenes::RenderSettings&)> model;
     int width = 0, height = 0;  ///< override of the camera's resolution (0: the scene's)
     /// Adds "self_shadowing" where the scene's effects name "shadows": the explicit needles
     /// always self-shadow, so a scene with "shadows" alone is compared with both

@@ -111,7 +111,7 @@ void checkEffects(const scenes::Effects& effects);
 /// replaced where `width` and `height` are > 0 (fov_deg is vertical: the view is kept, exactly
 /// when the aspect is). Throws what loadScene and checkEffects throw.
 scenes::Scene loadComparedScene(const std::filesystem::path& file,
-                                const std::function<void(scenes::ModelChoices&)>& model,
+                                const std::function<void(scenes::RenderSettings&)>& model,
                                 bool addSelfShadowing, int width, int height);
 
 /// A number for a person: `digits` significant digits.
