@@ -128,8 +128,11 @@ def plot_trees(directory):
     shades = {}
     for key in dict.fromkeys((r["method"], r["setting"]) for r in trees):
         method, setting = key
+        # An empty bias is undefined (the tree is black in the truth).
         points = [(float(r["coverage_px_truth"]), 100.0 * float(r["luminance_bias"]))
-                  for r in trees if (r["method"], r["setting"]) == key]
+                  for r in trees if (r["method"], r["setting"]) == key and r["luminance_bias"]]
+        if not points:
+            continue
         colour, marker, _ = STYLE.get(method, ("black", "x", method))
         shade = shades.get(method, 0)
         shades[method] = shade + 1

@@ -128,6 +128,13 @@ TEST(ImageDiff, MeasuresKnownErrors)
     EXPECT_NEAR(e.rmse, std::sqrt(2 * 0.04 / 8), 1e-6);
     EXPECT_NEAR(e.meanRelative, (2 * 0.2 / 0.5) / 8, 1e-6);
     EXPECT_THROW(compareImages(a, Image(3, 2)), ImageError);
+    // Against a black reference no pixel has a relative error: the mean is undefined (null in
+    // errors.json), not 0.
+    const ImageErrors black = compareImages(a, Image(a.width, a.height));
+    EXPECT_EQ(black.relativePixels, 0u);
+    EXPECT_TRUE(std::isnan(black.meanRelative));
+    EXPECT_EQ(black.toJson().at("mean_relative").dump(), "null");
+    EXPECT_GT(black.rmse, 0.4);
 }
 
 }  // namespace

@@ -289,6 +289,34 @@ TEST(TreeFoliage, BiasesFromTheSumsOfTwoRenders)
     EXPECT_EQ(treeBiases(image, truth, 0.0).size(), 3u);
 }
 
+TEST(TreeFoliage, ABlackTreeInTheTruthHasNoLuminanceBias)
+{
+    // Tree 0 is black in the truth (in deep shadow, no sky): any luminance of the image's is
+    // no ratio of it, so the bias is undefined, not 0%. Its coverage bias still stands, and
+    // the summary's luminance spread is over the trees where it is defined.
+    const std::vector<TreeFoliageSum> image{{0, 100.0, 30.0}, {1, 100.0, 45.0}};
+    const std::vector<TreeFoliageSum> truth{{0, 100.0, 0.0}, {1, 100.0, 50.0}};
+    const std::vector<TreeBias> b = treeBiases(image, truth);
+    ASSERT_EQ(b.size(), 2u);
+    EXPECT_TRUE(std::isnan(b[0].luminanceBias));
+    EXPECT_EQ(b[0].coverageBias, 0.0);
+    EXPECT_NEAR(b[1].luminanceBias, -0.1, 1e-12);
+    const TreeBiasSummary s = summarizeTreeBiases(b);
+    EXPECT_EQ(s.trees, 2u);
+    EXPECT_EQ(s.luminance.defined, 1u);
+    EXPECT_NEAR(s.luminance.median, -0.1, 1e-12);
+    EXPECT_NEAR(s.luminance.worst, -0.1, 1e-12);
+    EXPECT_EQ(s.luminance.worstTree, 1);
+    EXPECT_EQ(s.luminance.beyond, 1u);
+    EXPECT_EQ(s.coverage.defined, 2u);
+    // Only black trees: no median or worst to state.
+    const TreeBiasSummary none = summarizeTreeBiases({b[0]});
+    EXPECT_EQ(none.luminance.defined, 0u);
+    EXPECT_TRUE(std::isnan(none.luminance.median));
+    EXPECT_TRUE(std::isnan(none.luminance.worst));
+    EXPECT_EQ(none.luminance.worstTree, -1);
+}
+
 TEST(TreeFoliage, SumsRoundTripThroughAnExrHeader)
 {
     // Ten thousand trees (a landscape's), random sums: back bit for bit.

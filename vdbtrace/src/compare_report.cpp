@@ -21,7 +21,17 @@ constexpr int kNamedScale = 4;
 
 std::string percent(double fraction)
 {
-    return formatNumber(100.0 * fraction, 3) + "%";
+    return std::isnan(fraction) ? "-" : formatNumber(100.0 * fraction, 3) + "%";
+}
+
+// A number in the CSV files: empty where it is undefined (NaN), as they leave missing values.
+struct Csv {
+    double value;
+};
+std::ostream& operator<<(std::ostream& s, Csv c)
+{
+    if (!std::isnan(c.value)) s << c.value;
+    return s;
 }
 
 std::string scaleSection(const CompareRun& run, bool plotted)
@@ -227,7 +237,9 @@ std::string treeSection(const CompareRun& run, bool treePlot)
         std::vector<const TreeBias*> worst;
         for (const TreeBias& t : ms->treeBiases) worst.push_back(&t);
         std::sort(worst.begin(), worst.end(), [](const TreeBias* a, const TreeBias* b) {
-            return std::abs(a->luminanceBias) > std::abs(b->luminanceBias);
+            // Undefined biases (a black tree in the truth) last.
+            const double x = std::abs(a->luminanceBias), y = std::abs(b->luminanceBias);
+            return std::isnan(y) ? !std::isnan(x) : x > y;
         });
         worst.resize(std::min<std::size_t>(worst.size(), 5));
         s << "\nMultiscale (auto)'s trees farthest from the truth in luminance:";
@@ -304,7 +316,7 @@ std::string levelSection(const std::vector<CompareRow>& rows)
         const double share = double(l[k].pixels) * l[k].rmse * l[k].rmse / std::max(total, 1e-30);
         s << "| " << names[k] << " | " << l[k].pixels << " | "
           << (l[k].pixels ? formatNumber(l[k].rmse) : "-") << " | "
-          << (l[k].relativePixels ? formatNumber(l[k].meanRelative) : "-") << " | "
+          << (std::isnan(l[k].meanRelative) ? "-" : formatNumber(l[k].meanRelative)) << " | "
           << formatNumber(100.0 * share, 3) << "% |\n";
     }
     // Needle and cone levels pooled: the foliage shaded without a bough law.
@@ -366,7 +378,8 @@ std::string reportCsv(const CompareRun& run)
         s << r.method << ',' << r.setting << ',' << r.seconds << ',' << r.secondsMin << ','
           << r.secondsMax << ',' << r.wallSeconds << ',' << r.runs << ',';
         if (r.prepSeconds) s << *r.prepSeconds;
-        s << ',' << r.errors.rmse << ',' << r.errors.meanRelative << ',' << r.errors.maxAbsolute;
+        s << ',' << r.errors.rmse << ',' << Csv{r.errors.meanRelative} << ','
+          << r.errors.maxAbsolute;
         for (int level = 1; level <= 3; ++level) {
             s << ',';
             if (hasLevels(r) && r.errors.byLevel[level].pixels) s << r.errors.byLevel[level].rmse;
@@ -379,9 +392,9 @@ std::string reportCsv(const CompareRun& run)
         if (r.trees.trees) {
             const auto& l = r.trees.luminance;
             const auto& c = r.trees.coverage;
-            s << ',' << r.trees.trees << ',' << l.median << ',' << l.worst << ',' << l.worstTree
-              << ',' << l.beyond << ',' << c.median << ',' << c.worst << ',' << c.worstTree << ','
-              << c.beyond;
+            s << ',' << r.trees.trees << ',' << Csv{l.median} << ',' << Csv{l.worst} << ','
+              << l.worstTree << ',' << l.beyond << ',' << Csv{c.median} << ',' << Csv{c.worst}
+              << ',' << c.worstTree << ',' << c.beyond;
         } else {
             s << ",,,,,,,,,";
         }
@@ -390,7 +403,7 @@ std::string reportCsv(const CompareRun& run)
     if (run.truthCheck) {
         const ImageErrors& e = run.truthCheck->errors;
         s << "truth_check," << run.truthCheck->samples << "spp,,,,,,," << e.rmse << ','
-          << e.meanRelative << ',' << e.maxAbsolute << ",,,";
+          << Csv{e.meanRelative} << ',' << e.maxAbsolute << ",,,";
         errorColumns(e);
         s << ",,,,,,,,,,,\n";
     }
@@ -408,8 +421,8 @@ std::string treesCsv(const CompareRun& run)
         const CompareRow& r = *row;
         for (const TreeBias& t : r.treeBiases) {
             s << r.method << ',' << r.setting << ',' << t.truth.tree << ',' << t.image.coverage
-              << ',' << t.truth.coverage << ',' << t.coverageBias << ',' << t.image.luminance << ','
-              << t.truth.luminance << ',' << t.luminanceBias << '\n';
+              << ',' << t.truth.coverage << ',' << Csv{t.coverageBias} << ',' << t.image.luminance
+              << ',' << t.truth.luminance << ',' << Csv{t.luminanceBias} << '\n';
         }
     }
     return s.str();
@@ -515,8 +528,9 @@ std::string reportMd(const CompareRun& run, const scenes::Scene& scene, const Re
         }
         s << " | " << formatNumber(r.wallSeconds, 3) << " | "
           << (r.prepSeconds ? formatNumber(*r.prepSeconds, 3) : "") << " | "
-          << formatNumber(r.errors.rmse) << " | " << formatNumber(r.errors.meanRelative) << " | "
-          << formatNumber(r.errors.maxAbsolute);
+          << formatNumber(r.errors.rmse) << " | "
+          << (std::isnan(r.errors.meanRelative) ? "-" : formatNumber(r.errors.meanRelative))
+          << " | " << formatNumber(r.errors.maxAbsolute);
         for (int level = 1; level <= 3; ++level) {
             s << " | ";
             if (hasLevels(r) && r.errors.byLevel[level].pixels) {

@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace pine::vdbtrace {
 namespace {
+
+// A mean over no pixels.
+constexpr double kUndefined = std::numeric_limits<double>::quiet_NaN();
 
 double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
 
@@ -129,7 +133,7 @@ ImageErrors compareImages(const Image& image, const Image& reference, const std:
     for (std::size_t k = 0; k < e.byLevel.size(); ++k) {
         auto& l = e.byLevel[k];
         l.rmse = l.pixels ? std::sqrt(levelSq[k] / double(l.pixels)) : 0.0;
-        l.meanRelative = l.relativePixels ? levelRel[k] / double(l.relativePixels) : 0.0;
+        l.meanRelative = l.relativePixels ? levelRel[k] / double(l.relativePixels) : kUndefined;
     }
     // Luminance is linear in RGB, so a block's mean error is the error of the blocks' means.
     for (const int k : kErrorScales) {
@@ -154,7 +158,7 @@ ImageErrors compareImages(const Image& image, const Image& reference, const std:
     }
     e.pixels = n;
     e.rmse = std::sqrt(sumSq / double(std::max<std::size_t>(n, 1)));
-    e.meanRelative = e.relativePixels ? sumRelative / double(e.relativePixels) : 0.0;
+    e.meanRelative = e.relativePixels ? sumRelative / double(e.relativePixels) : kUndefined;
     return e;
 }
 

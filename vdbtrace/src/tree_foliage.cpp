@@ -95,6 +95,16 @@ std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int
     return out;
 }
 
+namespace {
+
+// A ratio - 1, undefined (NaN) against a truth of 0: a black tree's luminance bias is not 0%.
+double relativeBias(double image, double truth)
+{
+    return truth > 0.0 ? image / truth - 1.0 : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
 std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double minCoverage)
 {
     if (image.width != truth.width || image.height != truth.height) {
@@ -110,9 +120,8 @@ std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double 
     std::vector<TreeBias> out;
     for (std::size_t k = 0; k < b.size(); ++k) {  // the same regions, so the same trees
         if (!(b[k].coverage >= minCoverage) || !(b[k].coverage > 0.0)) continue;
-        TreeBias t{a[k], b[k], a[k].coverage / b[k].coverage - 1.0,
-                   b[k].luminance > 0.0 ? a[k].luminance / b[k].luminance - 1.0 : 0.0};
-        out.push_back(t);
+        out.push_back({a[k], b[k], relativeBias(a[k].coverage, b[k].coverage),
+                       relativeBias(a[k].luminance, b[k].luminance)});
     }
     return out;
 }
@@ -178,8 +187,8 @@ std::vector<TreeBias> treeBiases(const std::vector<TreeFoliageSum>& image,
         const auto it = shown.find(t.tree);
         const TreeFoliage a = it != shown.end() ? foliage(*it->second) : TreeFoliage{t.tree};
         const TreeFoliage b = foliage(t);
-        out.push_back({a, b, a.coverage / b.coverage - 1.0,
-                       b.luminance > 0.0 ? a.luminance / b.luminance - 1.0 : 0.0});
+        out.push_back(
+            {a, b, relativeBias(a.coverage, b.coverage), relativeBias(a.luminance, b.luminance)});
     }
     return out;
 }
@@ -195,12 +204,18 @@ TreeBiasSummary summarizeTreeBiases(const std::vector<TreeBias>& biases, double 
         std::vector<double> values;
         for (const TreeBias& t : biases) {
             const double v = t.*bias;
+            if (std::isnan(v)) continue;  // undefined: its truth is 0
             values.push_back(v);
             if (s.worstTree < 0 || std::abs(v) > std::abs(s.worst)) {
                 s.worst = v;
                 s.worstTree = t.truth.tree;
             }
             s.beyond += std::abs(v) > beyond;
+        }
+        s.defined = values.size();
+        if (values.empty()) {
+            s.median = s.worst = std::numeric_limits<double>::quiet_NaN();
+            return s;
         }
         std::sort(values.begin(), values.end());
         const std::size_t n = values.size();

@@ -1227,8 +1227,11 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
                                   {"luminance_bias", t.luminanceBias}};
             if (!byFragments) row["pixels"] = t.truth.pixels;  // of its region
             rows.push_back(row);
-            if (!worstLuminance ||
-                std::abs(t.luminanceBias) > std::abs(worstLuminance->luminanceBias)) {
+            // An undefined bias (NaN, null in the JSON: the tree is black in the reference) is
+            // no tree's worst.
+            if (!std::isnan(t.luminanceBias) &&
+                (!worstLuminance ||
+                 std::abs(t.luminanceBias) > std::abs(worstLuminance->luminanceBias))) {
                 worstLuminance = &t;
             }
             if (!worstCoverage ||
@@ -1237,17 +1240,28 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
             }
         }
         j["trees"] = rows;
-        if (worstLuminance) {
+        if (worstCoverage) {
             std::ostringstream s;
-            s << "; " << trees.size() << " trees, worst luminance bias "
-              << 100.0 * worstLuminance->luminanceBias << "% (tree " << worstLuminance->truth.tree
-              << "), worst coverage bias " << 100.0 * worstCoverage->coverageBias << "% (tree "
+            s << "; " << trees.size() << " trees, worst luminance bias ";
+            if (worstLuminance) {
+                s << 100.0 * worstLuminance->luminanceBias << "% (tree "
+                  << worstLuminance->truth.tree << ")";
+            } else {
+                s << "undefined (every tree black in the reference)";
+            }
+            s << ", worst coverage bias " << 100.0 * worstCoverage->coverageBias << "% (tree "
               << worstCoverage->truth.tree << ")";
             worst = s.str();
         }
     }
     vdbtrace::writeJsonAtomically(j, outDir / "errors.json");
-    std::cerr << "vdbtrace diff: rmse " << errors.rmse << ", mean relative " << errors.meanRelative
+    std::ostringstream meanRelative;
+    if (std::isnan(errors.meanRelative)) {
+        meanRelative << "undefined (a black reference)";
+    } else {
+        meanRelative << errors.meanRelative;
+    }
+    std::cerr << "vdbtrace diff: rmse " << errors.rmse << ", mean relative " << meanRelative.str()
               << ", max " << errors.maxAbsolute << worst << " -> " << outDir.string()
               << " (error.exr, error.png scaled 0.." << shown << ", errors.json)\n";
     return 0;

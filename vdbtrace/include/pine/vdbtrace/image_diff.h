@@ -14,7 +14,8 @@ namespace pine::vdbtrace {
 struct ImageErrors {
     Image error;             ///< RGB: |image - reference| per channel; AOV "error": luminance
     double rmse = 0.0;       ///< root mean square luminance error over all pixels
-    double meanRelative = 0.0;  ///< mean |e| / reference over pixels where reference > floor
+    /// mean |e| / reference over pixels where reference > floor; NaN (null in JSON) for none
+    double meanRelative = 0.0;
     double maxAbsolute = 0.0;
     double relativeFloor = 0.0;  ///< 1% of the reference's mean luminance
     std::size_t pixels = 0, relativePixels = 0;

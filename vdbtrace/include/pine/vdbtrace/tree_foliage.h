@@ -50,7 +50,8 @@ struct TreeFoliage {
 std::vector<TreeFoliage> foliageByTree(const Image& image, const std::vector<int>& regions,
                                        FoliageLuminance measure = FoliageLuminance::Own);
 
-/// A tree's foliage in an image over the truth's: coverage and luminance as ratios - 1.
+/// A tree's foliage in an image over the truth's: coverage and luminance as ratios - 1, NaN
+/// (undefined) where the truth's is 0.
 struct TreeBias {
     TreeFoliage image, truth;
     double coverageBias = 0.0, luminanceBias = 0.0;
@@ -82,12 +83,13 @@ std::vector<TreeBias> treeBiases(const std::vector<TreeFoliageSum>& image,
 /// A method's per-tree biases in a few numbers, as the reports state them.
 struct TreeBiasSummary {
     std::size_t trees = 0;  ///< compared (TreeBias entries)
-    /// Median and worst (the largest in magnitude, with its sign) of each bias, and the trees
-    /// whose bias exceeds `beyond` in magnitude; the worst tree's index.
+    /// Median and worst (the largest in magnitude, with its sign) of each bias over the trees
+    /// where it is defined (`defined` of them; NaN for none), and the trees whose bias exceeds
+    /// `beyond` in magnitude; the worst tree's index.
     struct Spread {
         double median = 0.0, worst = 0.0;
         int worstTree = -1;
-        std::size_t beyond = 0;
+        std::size_t beyond = 0, defined = 0;
     };
     Spread luminance, coverage;
     double beyond = 0.03;
