@@ -4,6 +4,8 @@
 #include "pine/scenes/colours.h"
 #include "pine/scenes/tree.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace pine::bake {
@@ -14,7 +16,10 @@ analytic::BoughGeometry boughGeometry(const scenes::NeedleParameters& p)
     g.cone.aperture_rad = p.aperture_rad;
     g.cone.needleLength_cm = p.length_cm;
     g.cone.needleRadius_cm = p.radius_cm;
-    g.cone.needlesPerCone = p.perCone;
+    // Whole needles: the explicit needles (NeedleLayout) draw a whole number a cone, so every
+    // method's N is that one, not the scene's mean over the bough (12 at the base and 9 at the
+    // tip is 10.5 at the middle; the needles draw 11, and so do the closed forms and the bake).
+    g.cone.needlesPerCone = std::max(1.0, std::round(p.perCone));
     g.coneSpacing_cm = p.coneSpacing_cm;
     return g;
 }

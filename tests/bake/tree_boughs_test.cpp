@@ -42,5 +42,22 @@ TEST(TreeBoughs, FollowTheSegmentsAtMidBoughInTheTracersHue)
     EXPECT_GT(grids.density->activeVoxelCount(), 100u * specs.size());
 }
 
+TEST(TreeBoughs, EveryMethodDrawsWholeNeedlesPerCone)
+{
+    // The explicit needles draw a whole number a cone; the closed forms, layers and bake take
+    // the same N through boughGeometry, so that a fractional per_cone (or one varying along a
+    // branch, read at a bough's middle) is not 1.5 needles to one method and 2 to another.
+    for (const auto& [perCone, drawn] : {std::pair{1.5, 2.0},
+                                         {1.0, 1.0},
+                                         {10.3, 10.0},
+                                         {10.5, 11.0},
+                                         {12.0, 12.0},
+                                         {11.7, 12.0}}) {
+        scenes::NeedleParameters p;
+        p.perCone = perCone;
+        EXPECT_EQ(boughGeometry(p).cone.needlesPerCone, drawn) << perCone;
+    }
+}
+
 }  // namespace
 }  // namespace pine::bake

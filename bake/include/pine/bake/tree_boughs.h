@@ -15,7 +15,7 @@ struct Tree;
 namespace pine::bake {
 
 /// A scene's needle parameters (scenes::NeedleParameters) as the shaders' type: the one place
-/// where one becomes the other.
+/// where one becomes the other. N is rounded to whole needles, as the explicit needles draw it.
 analytic::BoughGeometry boughGeometry(const scenes::NeedleParameters& p);
 
 /// The boughs of a grown tree (scenes::growTree, with its species set), one per tree.boughs in
