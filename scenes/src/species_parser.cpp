@@ -114,9 +114,10 @@ NeedleParameters readNeedles(const Json& value, const Where& where,
                   " cm): a line through a bough would cross more layers than that");
     }
     // Section 3.3: A = 2 N r / (pi R) is the fraction of the cone covered by needles; above 1
-    // the needles of one cone overlap and no shader level describes them.
+    // the needles of one cone overlap and no shader level describes them. N as every method
+    // draws it, in whole needles (bake::boughGeometry).
     const double A = analytic::layerCoverage(
-        analytic::ConeGeometry{p.aperture_rad, p.length_cm, p.radius_cm, p.perCone});
+        analytic::ConeGeometry{p.aperture_rad, p.length_cm, p.radius_cm, std::round(p.perCone)});
     if (A > 1.0) {
         where.fail("needles overlap on their cone: A = 2 N r / (pi l sin(phi)) = " +
                    formatNumber(A) + " > 1");

@@ -645,6 +645,11 @@ TEST(SceneParser, RejectsNeedlesThatCannotExist)
     j["species"]["fir"]["needles"]["tip"]["per_cone"] = 40;
     j["species"]["fir"]["needles"]["tip"]["radius"] = 0.2;
     expectError(j, "species.fir.needles.tip", "needles overlap");
+    // 11.6 needles of radius 0.2 would cover 0.985 of their cone, but every method draws 12:
+    // 1.019.
+    j["species"]["fir"]["needles"]["tip"]["per_cone"] = 11.6;
+    expectError(j, "species.fir.needles.tip",
+                "needles overlap on their cone: A = 2 N r / (pi l sin(phi)) = 1.018");
     // Cones 1e-6 cm apart: a line through a bough would cross millions of layers.
     j = fullScene();
     j["species"]["fir"]["needles"]["base"]["cone_spacing"] = 1e-6;
