@@ -95,6 +95,7 @@ TreeSample sumTrees(const scenes::Scene& scene, const std::vector<std::size_t>& 
 
 std::string count(double n)
 {
+    if (!std::isfinite(n)) return "more than 1e308";
     char text[64];
     std::snprintf(text, sizeof text, n < 1e6 ? "%.0f" : "%.3g", n);
     return text;
@@ -247,11 +248,22 @@ double memoryLimit(double gib) { return gib > 0.0 ? gib * kGiB : defaultMemoryLi
 
 std::string formatBytes(double bytes)
 {
-    char text[32];
-    if (bytes >= kGiB) {
+    // Rounded up below a GiB, so that an estimate is never shown as less than it is; small
+    // limits (--max-memory 1e-6) get small units, not "1 MiB" beside an estimate of 1 MiB.
+    if (!std::isfinite(bytes)) return "an unbounded amount";
+    char text[48];
+    if (bytes >= 1e6 * kGiB) {
+        std::snprintf(text, sizeof text, "%.3g GiB", bytes / kGiB);
+    } else if (bytes >= kGiB) {
         std::snprintf(text, sizeof text, "%.1f GiB", bytes / kGiB);
-    } else {
+    } else if (bytes >= 1024.0 * 1024.0) {
         std::snprintf(text, sizeof text, "%.0f MiB", std::ceil(bytes / (1024.0 * 1024.0)));
+    } else if (bytes >= 1024.0) {
+        std::snprintf(text, sizeof text, "%.0f KiB", std::ceil(bytes / 1024.0));
+    } else if (bytes >= 1.0) {
+        std::snprintf(text, sizeof text, "%.0f bytes", std::ceil(bytes));
+    } else {
+        std::snprintf(text, sizeof text, "%.3g bytes", bytes);
     }
     return text;
 }
@@ -260,6 +272,10 @@ void checkMemory(const ResourceEstimate& estimate, double limitBytes, const std:
 {
     const double total = estimate.bytes();
     if (!(total > limitBytes)) return;
+    if (!std::isfinite(total)) {
+        throw InputError(task + ": " + estimate.largest().what +
+                         " would need more memory than any machine has");
+    }
     throw InputError(task + ": " + estimate.largest().what + " needs about " +
                      formatBytes(estimate.largest().bytes) + " (" + formatBytes(total) +
                      " in all), more than --max-memory " + formatBytes(limitBytes) +

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <limits>
 #include <string>
 
 namespace pine::bake {
@@ -104,6 +105,20 @@ TEST(ResourceEstimate, EveryGrownTreeIsCounted)
         const double withVariants = method == "reference" ? 1.0 : 4.0 / 40.0;
         EXPECT_NEAR(grown(estimateRender(shared, method, 0.25)) / all, withVariants, 0.03);
     }
+}
+
+TEST(ResourceEstimate, AmountsAreWordedInTheirOwnUnits)
+{
+    // A limit of --max-memory 1e-300 GiB beside an estimate of 29 MiB read "1 MiB" and one of 100
+    // KiB, beside its estimate 1 MiB, read "needs 1 MiB, more than 1 MiB".
+    EXPECT_EQ(formatBytes(1.5 * 1024.0 * 1024.0 * 1024.0), "1.5 GiB");
+    EXPECT_EQ(formatBytes(29.2 * 1024.0 * 1024.0), "30 MiB");  // rounded up
+    EXPECT_EQ(formatBytes(100.0 * 1024.0), "100 KiB");
+    EXPECT_EQ(formatBytes(1000.0), "1000 bytes");
+    EXPECT_EQ(formatBytes(1e-291), "1e-291 bytes");
+    EXPECT_EQ(formatBytes(2e30), "1.86e+21 GiB");
+    EXPECT_EQ(formatBytes(std::numeric_limits<double>::infinity()), "an unbounded amount");
+    EXPECT_NE(formatBytes(1024.0 * 1024.0), formatBytes(100.0 * 1024.0));
 }
 
 }  // namespace

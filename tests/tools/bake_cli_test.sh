@@ -32,6 +32,9 @@ expect_error "unknown unit" 2 "units" -- tree "$bough" --tree 0 --voxel-size 1 -
 expect_error "unknown frame" 2 "frame" -- scene "$bough" --voxel-size 1 --frame local --out-dir "$work"
 # Voxels too fine for the machine: refused before the bake.
 expect_error "fine voxels, one tree" 2 "voxels of 0.001 cm" -- tree "$src/scenes/three-firs.json" --tree 2 --voxel-size 1e-3 --out "$work/a.vdb"
+# Voxels so fine that their count overflows: said so, not "inf voxels ... inf GiB".
+expect_error "voxels past counting" 2 "more than 1e308 voxels of 1e-300 cm would need more memory than any machine has" -- \
+    tree "$src/scenes/bough.json" --tree 0 --voxel-size 1e-300 --out "$work/a.vdb"
 expect_error "fine voxels, all trees" 2 "more than --max-memory" -- scene "$bough" --voxel-size 0.05 --max-memory 0.01 --out-dir "$work"
 # A scene in the output folder under a tree file's name is not baked over.
 mkdir "$work/inplace"

@@ -51,7 +51,8 @@ cmp -s "$src/scenes/bough.json" "$work/scene.exr" || fail "a refused render chan
 rm "$work/scene.exr"
 expect_error "png output" 2 "must end in .exr" -- render "$work/scene.json" --out "$work/a.png"
 expect_error "stats onto the image" 2 "same file" -- render "$work/scene.json" --out "$work/a.exr" --stats "$work/a.exr"
-expect_error "stats onto the preview" 2 "same file" -- render "$work/scene.json" --out "$work/a.exr" --stats "$work/a.png"
+expect_error "stats onto the preview" 2 "--stats '$work/a.png' is the preview written beside '$work/a.exr': give the stats another name" -- \
+    render "$work/scene.json" --out "$work/a.exr" --stats "$work/a.png"
 expect_error "stats onto the scene" 2 "also an input" -- render "$work/scene.json" --out "$work/a.exr" --stats "$work/scene.json"
 expect_error "device output" 2 "not a regular file" -- render "$work/scene.json" --out "$work/a.exr" --stats /dev/null
 cmp -s "$src/scenes/bough.json" "$work/scene.json" || fail "a refused render changed the scene"
@@ -293,6 +294,8 @@ grep -q '"level_blend": 1.0' "$work/p.json" || fail "--paper did not turn the le
     --stats "$work/n.json" 2>"$work/err" || fail "render --cone-level-max 0.3 failed: $(tail -1 "$work/err")"
 /usr/bin/python3 -c 'import json, math, sys; b = json.load(open(sys.argv[1]))["level_blend"]; sys.exit(abs(b - math.sqrt(0.3 / 0.25)) > 1e-12)' \
     "$work/n.json" || fail "--cone-level-max 0.3 did not record the narrowed band: $(grep level_blend "$work/n.json")"
+expect_error "an EXR without a name" 2 "--out '$work/.exr': the file needs a name before .exr" -- \
+    render "$src/scenes/bough.json" --out "$work/.exr"
 expect_error "a band too wide for the thresholds" 2 "--level-blend 2 must be at most sqrt(cone_level_max / needle_level_max) (1.09545) for cone_level_max 0.3" -- \
     render "$src/scenes/bough.json" --level-blend 2 --cone-level-max 0.3 --out "$work/n2.exr"
 grep -q '"layer_correlation": "needles"' "$work/b.json" || fail "default layer correlation not recorded as needles"

@@ -341,6 +341,11 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     // The extension decides the format: only EXR holds the render (its PNG goes beside it).
     std::string extension = out.extension().string();
     for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    std::string name = out.filename().string();
+    for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (name == ".exr") {  // a hidden file without an extension, to the library
+        throw InputError("--out '" + out.string() + "': the file needs a name before .exr");
+    }
     if (extension != ".exr") {
         throw InputError("--out '" + out.string() + "': the render is written as OpenEXR and " +
                          "its name must end in .exr (a PNG preview is written beside it)");
@@ -374,6 +379,14 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     for (const fs::path& g : gridFiles) {
         inputs.push_back(g);
         inputs.push_back(g.string() + ".json");
+    }
+    // The one clash the user cannot see in the names given: --stats named as a preview.
+    for (const fs::path& preview : previewsOf(first)) {
+        if (!firstStats.empty() && io::sameFile(firstStats, preview)) {
+            throw InputError("--stats '" + firstStats.string() +
+                             "' is the preview written beside '" + first.string() +
+                             "': give the stats another name");
+        }
     }
     std::vector<fs::path> firstFiles = previewsOf(first);
     firstFiles.insert(firstFiles.begin(), first);

@@ -64,7 +64,8 @@ double defaultMemoryLimit();
 /// --max-memory in GiB as bytes; 0 for defaultMemoryLimit().
 double memoryLimit(double gib);
 
-/// "1.5 GiB", "12 MiB".
+/// "1.5 GiB", "12 MiB", "3 KiB", "1e-291 bytes" (under a GiB rounded up), "an unbounded amount"
+/// (not finite).
 std::string formatBytes(double bytes);
 
 /// Throws InputError naming the estimate's largest part when the whole exceeds `limitBytes`:
