@@ -8,10 +8,14 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <new>
 #include <sstream>
@@ -110,16 +114,41 @@ std::ostream& info()
     return gQuiet ? discard : std::cerr;
 }
 
+namespace {
+
+std::string shown(double v)
+{
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+// Why `text` is not a number `wanted` (one the test `within` accepts), or empty.
+std::string whyNotANumber(const std::string& text, const std::string& wanted,
+                          const std::function<bool(double)>& within)
+{
+    const std::string refused = "must be a number " + wanted + ", got '" + text + "'";
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || end != text.c_str() + text.size()) return refused;
+    // strtod's range error: past the largest double, or below the smallest normal one (5e-324
+    // is a number > 0 to the user; to the tool it is 0 or a denormal).
+    if (errno == ERANGE) {
+        return refused + (std::abs(v) > 1.0 ? ", which overflows a double"
+                                            : ", which is below the smallest normal double (" +
+                                                  shown(std::numeric_limits<double>::min()) + ")");
+    }
+    return std::isfinite(v) && within(v) ? std::string() : refused;
+}
+
+}  // namespace
+
 CLI::Validator positiveNumber()
 {
     return CLI::Validator(
-        [](std::string& text) -> std::string {
-            try {
-                const double v = std::stod(text);
-                if (std::isfinite(v) && v > 0.0) return {};
-            } catch (const std::exception&) {
-            }
-            return "must be a number > 0, got '" + text + "'";
+        [](std::string& text) {
+            return whyNotANumber(text, "> 0", [](double v) { return v > 0.0; });
         },
         "> 0");
 }
@@ -141,22 +170,11 @@ CLI::Validator wholeNumberAtLeast(long least)
 
 CLI::Validator numberIn(double least, double most)
 {
-    const auto shown = [](double v) {
-        std::ostringstream s;
-        s << v;
-        return s.str();
-    };
     const std::string wanted =
         std::isinf(most) ? ">= " + shown(least) : "from " + shown(least) + " to " + shown(most);
     return CLI::Validator(
-        [=](std::string& text) -> std::string {
-            try {
-                std::size_t used = 0;
-                const double v = std::stod(text, &used);
-                if (used == text.size() && std::isfinite(v) && v >= least && v <= most) return {};
-            } catch (const std::exception&) {
-            }
-            return "must be a number " + wanted + ", got '" + text + "'";
+        [=](std::string& text) {
+            return whyNotANumber(text, wanted, [=](double v) { return v >= least && v <= most; });
         },
         std::isinf(most) ? ">= " + shown(least) : "in [" + shown(least) + ", " + shown(most) + "]");
 }

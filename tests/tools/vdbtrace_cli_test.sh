@@ -296,6 +296,11 @@ grep -q '"level_blend": 1.0' "$work/p.json" || fail "--paper did not turn the le
     "$work/n.json" || fail "--cone-level-max 0.3 did not record the narrowed band: $(grep level_blend "$work/n.json")"
 expect_error "an EXR without a name" 2 "--out '$work/.exr': the file needs a name before .exr" -- \
     render "$src/scenes/bough.json" --out "$work/.exr"
+# A number the tool cannot hold says why: 5e-324 is > 0 to the user, 0 or a denormal to a double.
+expect_error "an underflowing number" 2 "--cone-level-max: must be a number > 0, got '5e-324', which is below the smallest normal double" -- \
+    render "$src/scenes/bough.json" --cone-level-max 5e-324 --out "$work/n2.exr"
+expect_error "a number with a tail" 2 "--cone-level-max: must be a number > 0, got '3abc'" -- \
+    render "$src/scenes/bough.json" --cone-level-max 3abc --out "$work/n2.exr"
 expect_error "a band too wide for the thresholds" 2 "--level-blend 2 must be at most sqrt(cone_level_max / needle_level_max) (1.09545) for cone_level_max 0.3" -- \
     render "$src/scenes/bough.json" --level-blend 2 --cone-level-max 0.3 --out "$work/n2.exr"
 grep -q '"layer_correlation": "needles"' "$work/b.json" || fail "default layer correlation not recorded as needles"
