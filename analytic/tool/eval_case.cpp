@@ -3,6 +3,7 @@
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/cone_shader.h"
 #include "pine/analytic/needle_shader.h"
+#include "pine/support/input_error.h"
 
 #include <glm/geometric.hpp>
 
@@ -217,7 +218,7 @@ json parseLine(const std::string& line)
     if (!json::sax_parse(line, &parser)) {
         if (parser.overflow()) throw CaseError(parser.lastKey(), "must be finite");
         if (parser.duplicate()) throw CaseError(parser.lastKey(), "given twice");
-        throw json::parse_error::create(101, 0, parser.message(), nullptr);
+        throw CaseError("", "not JSON (" + withoutLibraryTags(parser.message()) + ")");
     }
     return result;
 }
@@ -261,7 +262,8 @@ int runEval(std::istream& in, std::ostream& out, std::ostream& err)
             const json input = parseLine(line);
             out << evaluateCase(input).dump() << '\n';
         } catch (const json::exception& e) {
-            err << "analytic eval: line " << number << ": not JSON (" << e.what() << ")\n";
+            err << "analytic eval: line " << number << ": not JSON ("
+                << withoutLibraryTags(e.what()) << ")\n";
             return 2;
         } catch (const CaseError& e) {
             err << "analytic eval: line " << number << ": ";

@@ -1,6 +1,7 @@
 #include "manifest.h"
 
 #include "pine/support/atomic_file.h"
+#include "pine/support/input_error.h"
 
 #include "pine/bake/tree_grids.h"
 
@@ -112,7 +113,7 @@ std::string readVerified(const fs::path& file, FileDigest* digest)
         accepted.push_back(recorded(j));
         if (j.contains("previous")) accepted.push_back(recorded(j.at("previous")));
     } catch (const nlohmann::json::exception& e) {
-        throw refuse("unreadable manifest: " + std::string(e.what()));
+        throw refuse("unreadable manifest: " + withoutLibraryTags(e.what()));
     }
     // The name is for people; size and checksum tie the manifest to the bytes, so a file renamed
     // with its manifest is still accepted.

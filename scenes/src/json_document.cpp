@@ -4,6 +4,7 @@
 #include "json_document.h"
 
 #include "pine/scenes/scene.h"
+#include "pine/support/input_error.h"
 
 #include <algorithm>
 #include <set>
@@ -133,8 +134,7 @@ std::string withoutPrefix(const std::string& what)
         const auto colon = what.find(marker, column);
         if (colon != std::string::npos) return what.substr(colon + marker.size());
     }
-    const auto bracket = what.find("] ");
-    return bracket == std::string::npos ? what : what.substr(bracket + 2);
+    return withoutLibraryTags(what);
 }
 
 std::string located(const std::string& file, const std::string& text, std::size_t index)

@@ -93,7 +93,9 @@ long long readInteger(const Json& v, const Where& where, long long lo, long long
     if (!v.is_number_integer()) where.fail(std::string("must be an integer, not ") + typeName(v));
     // Unsigned values above the signed range are out of any range we accept.
     const auto max = static_cast<unsigned long long>(hi);
-    if (v.is_number_unsigned() && v.get<unsigned long long>() > max) where.fail(range);
+    if (v.is_number_unsigned() && v.get<unsigned long long>() > max) {
+        where.fail(range + " (is " + std::to_string(v.get<unsigned long long>()) + ")");
+    }
     const long long x = v.get<long long>();
     if (x < lo || x > hi) where.fail(range + " (is " + std::to_string(x) + ")");
     return x;

@@ -114,6 +114,13 @@ TEST(EvalTool, NotJsonIsReportedWithItsLine)
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("line 3"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("not JSON"), std::string::npos) << r.err;
+    // Two objects on a line: said once, in plain words (it read "parse error: [json.exception.
+    // parse_error.101] parse error at ...").
+    const EvalRun two = run(kBough + " " + kBough + "\n");
+    EXPECT_EQ(two.status, 2);
+    EXPECT_NE(two.err.find("line 1: not JSON (parse error at line 1, column "), std::string::npos)
+        << two.err;
+    EXPECT_EQ(two.err.find("json.exception"), std::string::npos) << two.err;
 }
 
 }  // namespace

@@ -370,6 +370,14 @@ TEST(TreeGridsIo, AForeignManifestIsRefused)
     expectRefused(file, "unreadable manifest");
     writeFile(manifest, "{\"file\": \"tree.vdb\", \"bytes\": \"many\", \"fnv1a64\": \"0\"}");
     expectRefused(file, "unreadable manifest");
+    // In the manifest's words, without the JSON library's tags.
+    writeFile(manifest, "{\"bytes\": 1, \"fnv1a64\": \"0\"}");
+    expectRefused(file, "unreadable manifest: key 'file' not found");
+    try {
+        readTreeGrids(file);
+    } catch (const BakeError& e) {
+        EXPECT_EQ(std::string(e.what()).find("json.exception"), std::string::npos) << e.what();
+    }
     // The manifest of another bake beside this file.
     const fs::path other = dir.path() / "other.vdb";
     writeTreeGrids(twoBoughs(0.7, 1), other, kProvenance);

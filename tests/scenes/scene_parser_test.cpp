@@ -281,7 +281,7 @@ TEST(SceneParser, ScatterVariantsAreCopiesOfTheirFirstTree)
     EXPECT_EQ(firsts, 3);  // 40 trees from 3 variants: each drawn (certainly, for this seed)
     EXPECT_EQ(copies, 37);
     j["trees"][2]["scatter"]["variants"] = 41;
-    expectError(j, "trees[2].scatter.variants", "40");
+    expectError(j, "trees[2].scatter.variants", "must be in [1, 40] (is 41)");
     j["trees"][2]["scatter"]["variants"] = 0;
     expectError(j, "trees[2].scatter.variants", "1");
 }
@@ -481,7 +481,9 @@ TEST(SceneParser, RejectsWrongTypesAndShapes)
     expectError(j, "trees[0].seed", "must be an integer, not string");
     j = fullScene();
     j["trees"][0]["seed"] = -1;
-    expectError(j, "trees[0].seed", "must be in [0, 4294967295]");
+    expectError(j, "trees[0].seed", "must be in [0, 4294967295] (is -1)");
+    j["trees"][0]["seed"] = 4294967296u;  // unsigned to the JSON reader: said as -1 is
+    expectError(j, "trees[0].seed", "must be in [0, 4294967295] (is 4294967296)");
     j = fullScene();
     j["trees"][0]["position"] = {1, 2, 3, 4};
     expectError(j, "trees[0].position", "2 numbers");

@@ -36,4 +36,20 @@ inline std::string printable(std::string_view text, bool asciiOnly = false)
     return out;
 }
 
+/// A JSON library's message without its "[json.exception.parse_error.101] " tags (each of them,
+/// where one message wraps another), for an error line that says what is wrong in its own words.
+inline std::string withoutLibraryTags(std::string_view what)
+{
+    std::string out;
+    for (;;) {
+        const auto tag = what.find("[json.exception.");
+        const auto end = tag == std::string_view::npos ? tag : what.find("] ", tag);
+        if (end == std::string_view::npos) break;
+        out += what.substr(0, tag);
+        what.remove_prefix(end + 2);
+    }
+    out += what;
+    return out;
+}
+
 }  // namespace pine
