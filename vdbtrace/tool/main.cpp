@@ -235,6 +235,28 @@ fs::path besideWith(const fs::path& image, const std::string& suffix)
     return p.string() + suffix;
 }
 
+/// Every file `render` writes for one frame: its EXR, the previews beside it and its stats.
+struct FrameFiles {
+    fs::path exr, preview, levelPreview;  ///< NAME.exr, NAME.png, NAME.level.png
+    fs::path stats;                       ///< empty without --stats
+    bool levels = false;                  ///< whether the level preview is written (--aov level)
+
+    FrameFiles(const fs::path& exrFile, fs::path statsFile, bool withLevels)
+        : exr(exrFile),
+          preview(besideWith(exrFile, ".png")),
+          levelPreview(besideWith(exrFile, ".level.png")),
+          stats(std::move(statsFile)),
+          levels(withLevels)
+    {
+    }
+    /// The previews this frame writes.
+    std::vector<fs::path> previews() const
+    {
+        return levels ? std::vector<fs::path>{preview, levelPreview}
+                      : std::vector<fs::path>{preview};
+    }
+};
+
 /// What `render` changes of the scene's camera and frame from the command line.
 struct FrameOverrides {
     int width = 0, height = 0;      ///< --resolution (0: the scene's)
@@ -350,30 +372,26 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         throw InputError("--out '" + out.string() + "': the render is written as OpenEXR and " +
                          "its name must end in .exr (a PNG preview is written beside it)");
     }
-    // A frame's files: NAME.####.exr and its previews, stats as STATS.####.json.
-    const auto exrOf = [&](std::optional<int> f) { return f ? vdbtrace::frameFile(out, *f) : out; };
-    const auto statsOf = [&](std::optional<int> f) {
-        return f && !statsFile.empty() ? vdbtrace::frameFile(statsFile, *f, ".json") : statsFile;
-    };
-    const fs::path first = animation ? exrOf(frameRange->first) : out;
-    const fs::path firstStats = animation ? statsOf(frameRange->first) : statsFile;
     const bool levelPng = std::find(aovs.begin(), aovs.end(), "level") != aovs.end();
     if (levelPng && !method.levels) {
         throw InputError("--aov level: method '" + methodName +
                          "' has no levels (multiscale shades at the paper's levels)");
     }
-    // Every file a frame writes, beside its EXR: a folder named as a preview was found only
-    // after the render, which it lost (and with --aov level, after the preview was written).
-    const auto previewsOf = [&](const fs::path& exr) {
-        std::vector<fs::path> previews = {besideWith(exr, ".png")};
-        if (levelPng) previews.push_back(besideWith(exr, ".level.png"));
-        return previews;
+    // A frame's files: NAME.####.exr and its previews, stats as STATS.####.json. All are
+    // checked before the render: a folder named as a preview was found only after it, which
+    // it lost (and with --aov level, after the preview was written).
+    const auto filesOf = [&](std::optional<int> f) {
+        if (!f) return FrameFiles(out, statsFile, levelPng);
+        return FrameFiles(
+            vdbtrace::frameFile(out, *f),
+            statsFile.empty() ? statsFile : vdbtrace::frameFile(statsFile, *f, ".json"), levelPng);
     };
+    const FrameFiles first = filesOf(animation ? std::optional(frameRange->first) : std::nullopt);
     // Only the leader writes (the other ranks' machines may not see its folders).
     if (leader) {
-        io::checkWritable(first);
-        for (const fs::path& preview : previewsOf(first)) io::checkWritableName(preview);
-        if (!statsFile.empty()) io::checkWritable(firstStats);
+        io::checkWritable(first.exr);
+        for (const fs::path& preview : first.previews()) io::checkWritableName(preview);
+        if (!first.stats.empty()) io::checkWritable(first.stats);
     }
     std::vector<fs::path> inputs = {sceneFile};
     for (const fs::path& g : gridFiles) {
@@ -381,30 +399,30 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         inputs.push_back(g.string() + ".json");
     }
     // The one clash the user cannot see in the names given: --stats named as a preview.
-    for (const fs::path& preview : previewsOf(first)) {
-        if (!firstStats.empty() && io::sameFile(firstStats, preview)) {
-            throw InputError("--stats '" + firstStats.string() +
-                             "' is the preview written beside '" + first.string() +
+    for (const fs::path& preview : first.previews()) {
+        if (!first.stats.empty() && io::sameFile(first.stats, preview)) {
+            throw InputError("--stats '" + first.stats.string() +
+                             "' is the preview written beside '" + first.exr.string() +
                              "': give the stats another name");
         }
     }
-    std::vector<fs::path> firstFiles = previewsOf(first);
-    firstFiles.insert(firstFiles.begin(), first);
-    firstFiles.push_back(firstStats);
-    io::checkOutputsApart(firstFiles, inputs);
+    std::vector<fs::path> firstOutputs = first.previews();
+    firstOutputs.insert(firstOutputs.begin(), first.exr);
+    firstOutputs.push_back(first.stats);
+    io::checkOutputsApart(firstOutputs, inputs);
     if (animation) {  // every frame's files, not only the first's
         std::set<std::string> images, stats;
         for (int f = frameRange->first + 1; f <= frameRange->last; ++f) {
-            const fs::path exr = exrOf(f);
-            images.insert(exr.filename().string());
-            for (const fs::path& preview : previewsOf(exr)) {
+            const FrameFiles files = filesOf(f);
+            images.insert(files.exr.filename().string());
+            for (const fs::path& preview : files.previews()) {
                 images.insert(preview.filename().string());
                 if (leader) io::checkWritableName(preview);
             }
-            if (leader) io::checkWritableName(exr);
-            if (!statsFile.empty()) {
-                stats.insert(statsOf(f).filename().string());
-                if (leader) io::checkWritableName(statsOf(f));
+            if (leader) io::checkWritableName(files.exr);
+            if (!files.stats.empty()) {
+                stats.insert(files.stats.filename().string());
+                if (leader) io::checkWritableName(files.stats);
             }
         }
         const auto among = [](const std::set<std::string>& names) {
@@ -427,8 +445,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         if (leader) {
             toRender = vdbtrace::framesLeft(*frameRange, [&](int f) {
                 std::error_code error;
-                return frameComplete(exrOf(f), job) &&
-                       (statsFile.empty() || fs::is_regular_file(statsOf(f), error));
+                const FrameFiles files = filesOf(f);
+                return frameComplete(files.exr, job) &&
+                       (files.stats.empty() || fs::is_regular_file(files.stats, error));
             });
         }
         vdbtrace::Bytes list(toRender.size() * sizeof(int));
@@ -607,7 +626,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     const nlohmann::json effects = vdbtrace::toJson(vdbtrace::EffectsPlan::from(s.effects));
     // The law profiles and shadow columns are this rank's: told where one rank rendered all.
     const auto write = [&](const vdbtrace::RenderResult& result, std::optional<int> f, bool local) {
-        const fs::path exrFile = exrOf(f), stats = statsOf(f);
+        const FrameFiles files = filesOf(f);
         scenes::Camera seen = s.camera;
         if (f) seen = path.at(*f, still);
         const vdbtrace::ConeCamera camera(seen);
@@ -653,14 +672,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         // come from one run.
         const auto writeBeside = [&] {
             // The preview shows the scene's background behind what the cone did not cover.
-            vdbtrace::writePreviewPng(result.image, s.render.background,
-                                      besideWith(exrFile, ".png"));
-            for (const std::string& aov : aovs) {
-                if (aov == "level") {
-                    vdbtrace::writeLevelPng(result.image, besideWith(exrFile, ".level.png"));
-                }
-            }
-            if (!stats.empty()) {
+            vdbtrace::writePreviewPng(result.image, s.render.background, files.preview);
+            if (files.levels) vdbtrace::writeLevelPng(result.image, files.levelPreview);
+            if (!files.stats.empty()) {
                 nlohmann::json j = vdbtrace::toJson(result.stats);
                 j["seconds"] = result.seconds;
                 j["scene"] = sceneFile.string();
@@ -677,20 +691,21 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                 // rendered the whole image.
                 if (local) j.update(kept);
                 j.update(methodSettings);
-                vdbtrace::writeJsonAtomically(j, stats);
+                vdbtrace::writeJsonAtomically(j, files.stats);
             }
         };
-        const io::FolderLock turn(io::FolderLock::of(exrFile), [&] {
+        const io::FolderLock turn(io::FolderLock::of(files.exr), [&] {
             tool::info() << "vdbtrace: waiting for another run writing into '"
-                         << io::FolderLock::of(exrFile).string() << "'\n";
+                         << io::FolderLock::of(files.exr).string() << "'\n";
         });
-        for (const fs::path& file :
-             {exrFile, besideWith(exrFile, ".png"), besideWith(exrFile, ".level.png")}) {
-            io::removeStaleTemporaries(file);  // a killed run's: live ones wait for the lock
+        // A killed run's temporaries (live ones wait for the lock), the level preview's too
+        // where this run writes none.
+        for (const fs::path& file : {files.exr, files.preview, files.levelPreview}) {
+            io::removeStaleTemporaries(file);
         }
-        vdbtrace::writeExr(exr, exrFile, metadata, writeBeside);
+        vdbtrace::writeExr(exr, files.exr, metadata, writeBeside);
         const auto& st = result.stats;
-        tool::info() << "vdbtrace: " << exrFile.string() << ": " << result.image.width << "x"
+        tool::info() << "vdbtrace: " << files.exr.string() << ": " << result.image.width << "x"
                      << result.image.height << " in " << result.seconds << " s, " << st.coneRays
                      << " cone rays, " << st.shadowRays << " shadow rays; pixels by level "
                      << "needle/cone/bough " << st.pixelsPerLevel[1] << "/" << st.pixelsPerLevel[2]
