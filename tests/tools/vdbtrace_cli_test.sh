@@ -465,6 +465,8 @@ PY
 expect_error "bench --law-cache below 1 MiB" 2 "law-cache" -- \
     bench "$work/small-firs.json" --law-cache 0.5
 expect_error "bench --grow without a folder" 2 "grow-dir" -- bench "$work/small-firs.json" --grow resolution
+expect_error "bench --grow-dir without --grow" 2 "--grow-dir requires --grow" -- bench "$work/small-firs.json" --grow-dir "$work/g0"
+expect_error "bench --grow-steps without --grow" 2 "--grow-steps requires --grow" -- bench "$work/small-firs.json" --grow-steps 3
 expect_error "bench --grow, no scatter" 2 "no \"scatter\"" -- \
     bench "$work/small-firs.json" --grow trees-region --grow-dir "$work/grow-none"
 [ ! -e "$work/grow-none" ] || fail "a refused --grow made its folder"

@@ -3,6 +3,7 @@
 // samples), the report's errors at every scale and per-tree biases are what the EXRs it wrote
 // give, and the dolly's flicker is measured for the three methods.
 #include "pine/vdbtrace/compare.h"
+#include "pine/vdbtrace/dolly.h"
 #include "pine/vdbtrace/error_budget.h"
 #include "pine/vdbtrace/flicker.h"
 #include "pine/vdbtrace/image.h"
@@ -24,6 +25,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -151,6 +153,23 @@ TEST_F(Compare, FlickerIsMeasuredForTheThreeMethods)
     for (const auto& r : rows) {
         const double f = std::stod(r.at("flicker"));
         EXPECT_TRUE(std::isfinite(f) && f >= 0.0) << r.at("method");
+    }
+}
+
+TEST(Dolly, FramesKeepTheScenesShape)
+{
+    // 16 x 12 halved is 8 x 6: its short side raised to 8 keeps the shape (11 x 8), where the
+    // frames were made 8 x 8 and saw a wider view than the scene's.
+    CompareSettings settings = CompareSettings::forQuick(true);
+    settings.frames = 3;  // the fewest flicker is measured over
+    for (const auto& [w, h, fw, fh] :
+         {std::tuple{16, 12, 11, 8}, {48, 36, 24, 18}, {8, 6, 8, 6}, {1, 1, 1, 1}}) {
+        const scenes::Scene scene =
+            scenes::parseScene(test::firScene(R"("diffuse")", w, h), "fir.json");
+        const DollyFlicker d = measureDollyFlicker(scene, settings, {});
+        EXPECT_EQ(d.width, fw) << w << "x" << h;
+        EXPECT_EQ(d.height, fh) << w << "x" << h;
+        EXPECT_EQ(d.rows.size(), 3u);
     }
 }
 

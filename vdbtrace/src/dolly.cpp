@@ -3,6 +3,7 @@
 #include "pine/vdbtrace/animation_flicker.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace pine::vdbtrace {
 
@@ -11,8 +12,13 @@ DollyFlicker measureDollyFlicker(const scenes::Scene& base, const CompareSetting
 {
     DollyFlicker out;
     scenes::Camera still = base.camera;
-    out.width = still.width = std::max(8, base.camera.width / s.frameDivisor);
-    out.height = still.height = std::max(8, base.camera.height / s.frameDivisor);
+    // The frame divided by frameDivisor, its shape kept (a 16 x 12 frame made 8 x 8 widened
+    // the view), but not below 8 pixels on its short side unless the frame itself is.
+    const int w = base.camera.width, h = base.camera.height;
+    const double scale =
+        std::max(1.0 / s.frameDivisor, std::min(1.0, 8.0 / double(std::min(w, h))));
+    out.width = still.width = std::max(1, int(std::lround(w * scale)));
+    out.height = still.height = std::max(1, int(std::lround(h * scale)));
     // The camera backs away from its look-at, to dollyEnd times its distance.
     const scenes::Vec3 offset = still.position_cm - still.lookAt_cm;
     std::vector<scenes::Camera> cameras;

@@ -1467,24 +1467,29 @@ int main(int argc, char** argv)
     double growFactor = 2.0;
     fs::path growDir;
     bool growNoPlot = false;
-    benchCmd
-        ->add_option("--grow", growAxis,
-                     "Instead, grow the scene step by step and time both methods at each: "
-                     "trees-region (more trees, same region), trees-density (more trees, "
-                     "larger region), resolution (pixels) or needles (needles per cm of "
-                     "branch); writes the steps' scenes, growth.json, growth.csv and "
-                     "growth.png into --grow-dir")
-        ->check(CLI::IsMember(vdbtrace::growthAxisNames()));
+    CLI::Option* grow =
+        benchCmd
+            ->add_option("--grow", growAxis,
+                         "Instead, grow the scene step by step and time both methods at each: "
+                         "trees-region (more trees, same region), trees-density (more trees, "
+                         "larger region), resolution (pixels) or needles (needles per cm of "
+                         "branch); writes the steps' scenes, growth.json, growth.csv and "
+                         "growth.png into --grow-dir")
+            ->check(CLI::IsMember(vdbtrace::growthAxisNames()));
+    // Without --grow these would be ignored without a word.
     benchCmd->add_option("--grow-steps", growSteps, "Steps of --grow, the first the scene as is")
         ->check(CLI::Range(2, 8))
-        ->capture_default_str();
+        ->capture_default_str()
+        ->needs(grow);
     benchCmd
         ->add_option("--grow-factor", growFactor,
                      "What each step of --grow multiplies: trees, pixels or needles")
         ->check(tool::numberIn(1.1, 16.0))
-        ->capture_default_str();
-    benchCmd->add_option("--grow-dir", growDir, "Folder for --grow's outputs");
-    benchCmd->add_flag("--no-plot", growNoPlot, "--grow: no growth.png (no python3 needed)");
+        ->capture_default_str()
+        ->needs(grow);
+    benchCmd->add_option("--grow-dir", growDir, "Folder for --grow's outputs")->needs(grow);
+    benchCmd->add_flag("--no-plot", growNoPlot, "--grow: no growth.png (no python3 needed)")
+        ->needs(grow);
     addMaxMemory(*benchCmd, maxMemoryGiB, "a step of --grow");
     model.add(*benchCmd);
 

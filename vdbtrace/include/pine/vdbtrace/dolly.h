@@ -21,7 +21,8 @@ struct DollyFlicker {
 };
 
 /// settings.frames frames, camera distance x 1 to x settings.dollyEnd, at the scene's
-/// resolution / settings.frameDivisor; the scene is prepared again per frame (the per-bough
+/// resolution / settings.frameDivisor, its shape kept and its short side no less than 8 pixels
+/// where the scene's is not; the scene is prepared again per frame (the per-bough
 /// shading depends on the camera). `log` hears each frame.
 DollyFlicker measureDollyFlicker(const scenes::Scene& base, const CompareSettings& settings,
                                  const CompareLog& log);
