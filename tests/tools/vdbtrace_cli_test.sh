@@ -551,6 +551,13 @@ rm "$work/seq/s.0003.json"
     fail "stats on resume: exit $?"
 grep -q "2 of 3 frames already rendered by this job, kept" "$work/err" && [ -s "$work/seq/s.0003.json" ] ||
     fail "stats on resume: frame 3's stats: $(grep -v % "$work/err" | head -3)"
+# Stats another job wrote (no job, or another) are not this job's: their frame is rendered again.
+printf '{"frame": 2, "method": "multiscale"}\n' >"$work/seq/s.0002.json"
+"$vdbtrace" render "$src/scenes/three-firs.json" --frames 2-4 --resolution 32x24 \
+    --method geometry --samples 2 --out "$work/seq/f.exr" --stats "$work/seq/s.json" 2>"$work/err" ||
+    fail "foreign stats on resume: exit $?"
+grep -q "2 of 3 frames already rendered by this job, kept" "$work/err" && grep -q '"job"' "$work/seq/s.0002.json" ||
+    fail "foreign stats on resume were kept: $(grep -v % "$work/err" | head -3)"
 # A later frame's preview or stats where a folder is: refused before the first frame.
 mkdir "$work/seq/g.0004.png"
 expect_error "a later frame's preview onto a folder" 2 "cannot write '.*g.0004.png': it is a folder" -- render "$src/scenes/three-firs.json" --frames 2-4 --resolution 8x6 --out "$work/seq/g.exr"

@@ -345,6 +345,15 @@ bool frameComplete(const fs::path& file, const std::string& job)
     return false;
 }
 
+/// Whether `file` is a frame's stats this job wrote (they record the job as its EXR does): a
+/// stats file of another job, or a damaged one, is written again with its frame.
+bool statsComplete(const fs::path& file, const std::string& job)
+{
+    std::ifstream in(file);
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    return j.is_object() && j.contains("job") && j["job"] == job;
+}
+
 int render(const fs::path& sceneFile, const std::string& methodName, const fs::path& out,
            const fs::path& statsFile, const std::vector<std::string>& aovs,
            vdbtrace::MethodSettings settings, const std::vector<fs::path>& gridFiles,
@@ -444,10 +453,9 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     if (animation) {
         if (leader) {
             toRender = vdbtrace::framesLeft(*frameRange, [&](int f) {
-                std::error_code error;
                 const FrameFiles files = filesOf(f);
                 return frameComplete(files.exr, job) &&
-                       (files.stats.empty() || fs::is_regular_file(files.stats, error));
+                       (files.stats.empty() || statsComplete(files.stats, job));
             });
         }
         vdbtrace::Bytes list(toRender.size() * sizeof(int));
@@ -684,7 +692,10 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                 if (!frame.crop.empty()) {
                     j["crop"] = {frame.crop.x0, frame.crop.y0, frame.crop.x1, frame.crop.y1};
                 }
-                if (f) j["frame"] = *f;
+                if (f) {
+                    j["frame"] = *f;
+                    j["job"] = job;  // as the EXR's pine:job: what a resumed job keeps
+                }
                 j["threads"] = tbb::this_task_arena::max_concurrency();
                 j["ranks"] = ranks.size();
                 // The law profiles and shadow columns are this rank's: told where it
