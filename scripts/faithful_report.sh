@@ -44,8 +44,12 @@ if not rows:
     print("   (no trees)")
     sys.exit()
 for key in ("coverage_bias", "luminance_bias"):
-    b = [r[key] for r in rows]
-    worst = max(rows, key=lambda r: abs(r[key]))
+    defined = [r for r in rows if r[key] is not None]  # null: the tree is black in the truth
+    if not defined:
+        print("   per tree %-15s undefined for every tree" % key)
+        continue
+    b = [r[key] for r in defined]
+    worst = max(defined, key=lambda r: abs(r[key]))
     off = sum(abs(x) > 0.03 for x in b)
     print("   per tree %-15s median %+6.1f%%  worst %+6.1f%% (tree %d)  off by >3%%: %d of %d"
           % (key, 100 * statistics.median(b), 100 * worst[key], worst["tree"], off, len(b)))

@@ -46,7 +46,10 @@ import json, statistics, sys
 rows = json.load(open(sys.argv[2]))["trees"]
 line = "%-44s" % sys.argv[1]
 for key in ("coverage_bias", "luminance_bias"):
-    b = [r[key] for r in rows]
+    b = [r[key] for r in rows if r[key] is not None]  # null: the tree is black in the truth
+    if not b:
+        line += "  %s undefined" % key[:3]
+        continue
     worst = max(b, key=abs)
     line += "  %s median %+5.1f%% worst %+5.1f%% off %2d/%d" % (
         key[:3], 100 * statistics.median(b), 100 * worst, sum(abs(x) > 0.03 for x in b), len(b))

@@ -31,7 +31,12 @@ load = lambda p: {r["tree"]: r for r in json.load(open(p))["trees"]}
 a, b = load(sys.argv[2]), load(sys.argv[3])
 line = "%-44s" % sys.argv[1]
 for key in ("coverage_bias", "luminance_bias"):
-    r = sorted((1 + a[k][key]) / (1 + b[k][key]) - 1 for k in a if k in b)
+    # null: the tree is black in a truth, and has no ratio
+    r = sorted((1 + a[k][key]) / (1 + b[k][key]) - 1 for k in a
+               if k in b and a[k][key] is not None and b[k][key] is not None)
+    if not r:
+        line += "  %s undefined" % key[:3]
+        continue
     line += "  %s median %+5.1f%% p10 %+5.1f%% p90 %+5.1f%% off %2d/%d" % (
         key[:3], 100 * statistics.median(r), 100 * r[len(r) // 10],
         100 * r[9 * len(r) // 10], sum(abs(x) > 0.03 for x in r), len(r))

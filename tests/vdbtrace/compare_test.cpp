@@ -3,6 +3,7 @@
 // samples), the report's errors at every scale and per-tree biases are what the EXRs it wrote
 // give, and the dolly's flicker is measured for the three methods.
 #include "pine/vdbtrace/compare.h"
+#include "pine/vdbtrace/compare_report.h"
 #include "pine/vdbtrace/dolly.h"
 #include "pine/vdbtrace/error_budget.h"
 #include "pine/vdbtrace/flicker.h"
@@ -19,6 +20,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -442,6 +444,53 @@ TEST(CompareRun, EverySettingRunsOnceARoundInTheReportsOrder)
         EXPECT_LE(r.seconds, r.secondsMax) << r.stem();
         EXPECT_EQ(r.image.width, 48) << r.stem();  // the first run's image, kept
     }
+}
+
+TEST(CompareRun, ABlackTruthHasNoLuminanceBiasInAnyReport)
+{
+    // A fir whose needles and bark reflect nothing: its luminance biases are undefined, so
+    // the reports leave them out ('-', empty cells) where they read 0% or nan, while its
+    // coverage biases stand.
+    std::string black = kFirScene;
+    for (const std::string key :
+         {"\"bark_albedo\": 0.25", "\"needle_albedo\": 0.3", "\"needle_specular\": 0.2"}) {
+        const std::size_t at = black.find(key);
+        ASSERT_NE(at, std::string::npos) << key;
+        black.replace(at, key.size(), key.substr(0, key.find(':')) + ": 0");
+    }
+    const scenes::Scene scene = scenes::parseScene(black, "fir.json");
+    CompareSettings st;
+    st.truthSamples = 4;
+    st.truthCheckFactor = 0;
+    st.repeat = 1;
+    st.budget = false;
+    st.geometrySamples = {1};
+    st.voxelSizes_cm = {};
+    st.levels = {0};
+    const CompareRun run = runComparison(scene, st, {});
+    // "nan" as a number prints it, not inside a word ("luminance").
+    const auto printsNan = [](const std::string& text) {
+        for (std::size_t at = text.find("nan"); at != std::string::npos;
+             at = text.find("nan", at + 1)) {
+            if (at == 0 || !std::isalpha(static_cast<unsigned char>(text[at - 1]))) return true;
+        }
+        return false;
+    };
+    const CompareRow& ms = run.rows.back();
+    ASSERT_EQ(ms.method, "multiscale");
+    ASSERT_GT(ms.trees.trees, 0u);
+    EXPECT_EQ(ms.trees.luminance.defined, 0u);
+    EXPECT_EQ(ms.trees.coverage.defined, ms.trees.trees);
+    EXPECT_TRUE(ms.foliageCoverageBias.has_value());
+    EXPECT_FALSE(ms.foliageLuminanceBias.has_value());
+    for (const std::string& text : {reportCsv(run), treesCsv(run)}) {
+        EXPECT_FALSE(printsNan(text)) << text;
+        EXPECT_EQ(text.find(",-1,"), std::string::npos) << "no worst tree: " << text;
+    }
+    const std::string md = reportMd(run, scene, ReportInfo{});
+    EXPECT_FALSE(printsNan(md)) << md;
+    EXPECT_EQ(md.find("(knows no trees)"), std::string::npos) << md;
+    EXPECT_NE(md.find("luminance undefined (black in the truth)"), std::string::npos) << md;
 }
 
 TEST(CompareRun, UnwritableFolderFailsBeforeWork)

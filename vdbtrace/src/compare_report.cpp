@@ -132,6 +132,7 @@ std::vector<const CompareRow*> sweepThenBudget(const CompareRun& run, bool truth
 std::string withChange(double value, double own, bool asPercent)
 {
     const double d = value - own;
+    if (std::isnan(d)) return asPercent ? percent(value) : formatNumber(value);  // undefined
     if (asPercent) {
         return percent(value) + " (" + (d >= 0.0 ? "+" : "") + formatNumber(100.0 * d, 3) + " pts)";
     }
@@ -225,10 +226,16 @@ std::string treeSection(const CompareRun& run, bool treePlot)
         }
         const auto& l = r.trees.luminance;
         const auto& c = r.trees.coverage;
-        s << percent(*r.foliageCoverageBias) << " | " << percent(*r.foliageLuminanceBias) << " | "
-          << percent(l.median) << " | " << percent(l.worst) << " (tree " << l.worstTree << ") | "
-          << l.beyond << " | " << percent(c.median) << " | " << percent(c.worst) << " (tree "
-          << c.worstTree << ") | " << c.beyond << " |\n";
+        // "-" where no tree's bias is defined (every tree black in the truth).
+        const auto worst = [](const TreeBiasSummary::Spread& spread) {
+            return spread.defined
+                       ? percent(spread.worst) + " (tree " + std::to_string(spread.worstTree) + ")"
+                       : std::string("-");
+        };
+        s << percent(*r.foliageCoverageBias) << " | "
+          << (r.foliageLuminanceBias ? percent(*r.foliageLuminanceBias) : "-") << " | "
+          << percent(l.median) << " | " << worst(l) << " | " << l.beyond << " | "
+          << percent(c.median) << " | " << worst(c) << " | " << c.beyond << " |\n";
     }
     if (treePlot) s << "\n![Bias per tree](tree_bias.png)\n";
     // The trees a reader should look at first: multiscale's farthest from the truth.
@@ -245,7 +252,9 @@ std::string treeSection(const CompareRun& run, bool treePlot)
         s << "\nMultiscale (auto)'s trees farthest from the truth in luminance:";
         for (const TreeBias* t : worst) {
             s << (t == worst.front() ? " " : "; ") << "tree " << t->truth.tree << " ("
-              << std::lround(t->truth.coverage) << " px of foliage) " << percent(t->luminanceBias)
+              << std::lround(t->truth.coverage) << " px of foliage) "
+              << (std::isnan(t->luminanceBias) ? "luminance undefined (black in the truth)"
+                                               : percent(t->luminanceBias))
               << ", coverage " << percent(t->coverageBias);
         }
         s << ".\n";
@@ -392,9 +401,13 @@ std::string reportCsv(const CompareRun& run)
         if (r.trees.trees) {
             const auto& l = r.trees.luminance;
             const auto& c = r.trees.coverage;
+            // A worst tree only where some tree's bias is defined.
+            const auto worstTree = [](const TreeBiasSummary::Spread& spread) {
+                return spread.defined ? std::to_string(spread.worstTree) : std::string();
+            };
             s << ',' << r.trees.trees << ',' << Csv{l.median} << ',' << Csv{l.worst} << ','
-              << l.worstTree << ',' << l.beyond << ',' << Csv{c.median} << ',' << Csv{c.worst}
-              << ',' << c.worstTree << ',' << c.beyond;
+              << worstTree(l) << ',' << l.beyond << ',' << Csv{c.median} << ',' << Csv{c.worst}
+              << ',' << worstTree(c) << ',' << c.beyond;
         } else {
             s << ",,,,,,,,,";
         }

@@ -92,8 +92,10 @@ void measureTrees(CompareRow& row, const CompareRow& truth)
         return all;
     };
     const TreeFoliageSum a = total(row.treeFoliage), b = total(truth.treeFoliage);
+    // The luminance bias is undefined where the truth's foliage is black; its coverage's
+    // stands.
+    if (b.coverage_px > 0.0) row.foliageCoverageBias = a.coverage_px / b.coverage_px - 1.0;
     if (b.coverage_px > 0.0 && b.luminance > 0.0 && a.coverage_px > 0.0) {
-        row.foliageCoverageBias = a.coverage_px / b.coverage_px - 1.0;
         row.foliageLuminanceBias =
             (a.luminance / a.coverage_px) / (b.luminance / b.coverage_px) - 1.0;
     }
@@ -190,7 +192,7 @@ CompareRun runComparison(const scenes::Scene& scene, const CompareSettings& st,
         }
         if (row.prepSeconds) line += " (" + formatNumber(*row.prepSeconds, 3) + " s preparation)";
         if (!row.truth) line += ", rmse " + formatNumber(row.errors.rmse);
-        if (!row.truth && row.trees.trees) {
+        if (!row.truth && row.trees.luminance.defined) {
             line += ", per-tree luminance median " +
                     formatNumber(100.0 * row.trees.luminance.median, 3) + "%";
         }
