@@ -4,8 +4,6 @@
 #include "pine/scenes/colours.h"
 #include "pine/scenes/tree.h"
 
-#include <algorithm>
-#include <cmath>
 #include <stdexcept>
 
 namespace pine::bake {
@@ -19,7 +17,7 @@ analytic::BoughGeometry boughGeometry(const scenes::NeedleParameters& p)
     // Whole needles: the explicit needles (NeedleLayout) draw a whole number a cone, so every
     // method's N is that one, not the scene's mean over the bough (12 at the base and 9 at the
     // tip is 10.5 at the middle; the needles draw 11, and so do the closed forms and the bake).
-    g.cone.needlesPerCone = std::max(1.0, std::round(p.perCone));
+    g.cone.needlesPerCone = scenes::wholeNeedles(p.perCone);
     g.coneSpacing_cm = p.coneSpacing_cm;
     return g;
 }

@@ -70,7 +70,7 @@ double Bough::coneCount(double length_cm) const
 
 double Bough::needleCount(double length_cm) const
 {
-    return length_cm * needlesPerLength(atBase, atTip);
+    return coneCount(length_cm) * wholeNeedles(lerp(atBase, atTip, 0.5).perCone);
 }
 
 TreeCounts Tree::counts() const

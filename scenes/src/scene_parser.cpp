@@ -241,7 +241,7 @@ RenderSettings readRender(const Json& value, const Where& where)
     }
     // The two bands must not overlap: a bough is mixed from two levels at most. Thresholds
     // closer than the default band allows narrow it.
-    const double widest = std::sqrt(s.model.coneLevelMax / s.needleLevelMax);
+    const double widest = s.widestLevelBlend();
     s.model.levelBlend = r.number("level_blend", Range::atLeast(1),
                                   std::min(s.model.levelBlend, widest));
     if (s.model.levelBlend > widest) {

@@ -117,7 +117,7 @@ NeedleParameters readNeedles(const Json& value, const Where& where,
     // the needles of one cone overlap and no shader level describes them. N as every method
     // draws it, in whole needles (bake::boughGeometry).
     const double A = analytic::layerCoverage(
-        analytic::ConeGeometry{p.aperture_rad, p.length_cm, p.radius_cm, std::round(p.perCone)});
+        analytic::ConeGeometry{p.aperture_rad, p.length_cm, p.radius_cm, wholeNeedles(p.perCone)});
     if (A > 1.0) {
         where.fail("needles overlap on their cone: A = 2 N r / (pi l sin(phi)) = " +
                    formatNumber(A) + " > 1");

@@ -375,6 +375,7 @@ TEST(TreeGridsIo, AForeignManifestIsRefused)
     expectRefused(file, "unreadable manifest: key 'file' not found");
     try {
         readTreeGrids(file);
+        ADD_FAILURE() << "a manifest without 'file' was accepted";
     } catch (const BakeError& e) {
         EXPECT_EQ(std::string(e.what()).find("json.exception"), std::string::npos) << e.what();
     }

@@ -239,20 +239,27 @@ TEST(Bough, CountsIntegrateAlongIt)
     Bough b;
     EXPECT_NEAR(b.coneCount(9.0), 10.0, 1e-12);  // 9 cm / 0.9 cm
     EXPECT_NEAR(b.needleCount(9.0), 120.0, 1e-10);
-    // Varying spacing and needles per cone: against a fine midpoint sum of N / dh.
+    // Varying spacing: cones against a fine midpoint sum of 1 / dh; needles are the cones
+    // times the middle's N in whole needles, as every method draws them (12 to 8 is 10 at the
+    // middle, 12 to 9 is 10.5 and drawn 11).
     for (double tipSpacing : {0.9 * 1.005, 0.5, 2.0}) {
         b.atTip.coneSpacing_cm = tipSpacing;
-        b.atTip.perCone = 8;
-        double cones = 0.0, needles = 0.0;
+        double cones = 0.0;
         const int n = 200000;
         for (int i = 0; i < n; ++i) {
             const NeedleParameters p = lerp(b.atBase, b.atTip, (i + 0.5) / n);
             cones += 7.0 / n / p.coneSpacing_cm;
-            needles += 7.0 / n * p.perCone / p.coneSpacing_cm;
         }
         EXPECT_NEAR(b.coneCount(7.0), cones, 1e-8 * cones) << tipSpacing;
-        EXPECT_NEAR(b.needleCount(7.0), needles, 1e-8 * needles) << tipSpacing;
+        for (const auto& [tipNeedles, drawn] : {std::pair{8.0, 10.0}, {9.0, 11.0}}) {
+            b.atTip.perCone = tipNeedles;
+            EXPECT_NEAR(b.needleCount(7.0), drawn * cones, 1e-8 * cones) << tipSpacing;
+        }
+        b.atTip.perCone = b.atBase.perCone;
     }
+    // 1.5 needles a cone are drawn as 2.
+    b.atBase.perCone = b.atTip.perCone = 1.5;
+    EXPECT_NEAR(b.needleCount(7.0), 2.0 * b.coneCount(7.0), 1e-12);
 }
 
 TEST(Tree, HeightForATreeWithoutHeightThrows)

@@ -294,11 +294,15 @@ grep -q '"level_blend": 1.0' "$work/p.json" || fail "--paper did not turn the le
     --stats "$work/n.json" 2>"$work/err" || fail "render --cone-level-max 0.3 failed: $(tail -1 "$work/err")"
 /usr/bin/python3 -c 'import json, math, sys; b = json.load(open(sys.argv[1]))["level_blend"]; sys.exit(abs(b - math.sqrt(0.3 / 0.25)) > 1e-12)' \
     "$work/n.json" || fail "--cone-level-max 0.3 did not record the narrowed band: $(grep level_blend "$work/n.json")"
+grep -q "level_blend 1.5 narrowed to 1.09545 to keep the bands about needle_level_max 0.25 and cone_level_max 0.3 apart" "$work/err" ||
+    fail "the narrowed band was not said: $(head -2 "$work/err")"
 expect_error "an EXR without a name" 2 "--out '$work/.exr': the file needs a name before .exr" -- \
     render "$src/scenes/bough.json" --out "$work/.exr"
 # A number the tool cannot hold says why: 5e-324 is > 0 to the user, 0 or a denormal to a double.
 expect_error "an underflowing number" 2 "--cone-level-max: must be a number > 0, got '5e-324', which is below the smallest normal double" -- \
     render "$src/scenes/bough.json" --cone-level-max 5e-324 --out "$work/n2.exr"
+expect_error "an overflowing number" 2 "--cone-level-max: must be a number > 0, got '1e400', which overflows a double" -- \
+    render "$src/scenes/bough.json" --cone-level-max 1e400 --out "$work/n2.exr"
 expect_error "a number with a tail" 2 "--cone-level-max: must be a number > 0, got '3abc'" -- \
     render "$src/scenes/bough.json" --cone-level-max 3abc --out "$work/n2.exr"
 expect_error "a band too wide for the thresholds" 2 "--level-blend 2 must be at most sqrt(cone_level_max / needle_level_max) (1.09545) for cone_level_max 0.3" -- \
@@ -467,6 +471,8 @@ expect_error "bench --law-cache below 1 MiB" 2 "law-cache" -- \
 expect_error "bench --grow without a folder" 2 "grow-dir" -- bench "$work/small-firs.json" --grow resolution
 expect_error "bench --grow-dir without --grow" 2 "--grow-dir requires --grow" -- bench "$work/small-firs.json" --grow-dir "$work/g0"
 expect_error "bench --grow-steps without --grow" 2 "--grow-steps requires --grow" -- bench "$work/small-firs.json" --grow-steps 3
+expect_error "bench --grow-factor without --grow" 2 "--grow-factor requires --grow" -- bench "$work/small-firs.json" --grow-factor 3
+expect_error "bench --no-plot without --grow" 2 "--no-plot requires --grow" -- bench "$work/small-firs.json" --no-plot
 expect_error "bench --grow, no scatter" 2 "no \"scatter\"" -- \
     bench "$work/small-firs.json" --grow trees-region --grow-dir "$work/grow-none"
 [ ! -e "$work/grow-none" ] || fail "a refused --grow made its folder"

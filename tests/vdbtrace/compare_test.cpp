@@ -164,8 +164,11 @@ TEST(Dolly, FramesKeepTheScenesShape)
     // frames were made 8 x 8 and saw a wider view than the scene's.
     CompareSettings settings = CompareSettings::forQuick(true);
     settings.frames = 3;  // the fewest flicker is measured over
-    for (const auto& [w, h, fw, fh] :
-         {std::tuple{16, 12, 11, 8}, {48, 36, 24, 18}, {8, 6, 8, 6}, {1, 1, 1, 1}}) {
+    for (const auto& [w, h, fw, fh] : {std::tuple{16, 12, 11, 8},
+                                       {48, 36, 24, 18},
+                                       {49, 37, 24, 18},
+                                       {8, 6, 8, 6},
+                                       {1, 1, 1, 1}}) {
         const scenes::Scene scene =
             scenes::parseScene(test::firScene(R"("diffuse")", w, h), "fir.json");
         const DollyFlicker d = measureDollyFlicker(scene, settings, {});

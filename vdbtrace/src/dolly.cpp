@@ -12,13 +12,18 @@ DollyFlicker measureDollyFlicker(const scenes::Scene& base, const CompareSetting
 {
     DollyFlicker out;
     scenes::Camera still = base.camera;
-    // The frame divided by frameDivisor, its shape kept (a 16 x 12 frame made 8 x 8 widened
-    // the view), but not below 8 pixels on its short side unless the frame itself is.
-    const int w = base.camera.width, h = base.camera.height;
-    const double scale =
-        std::max(1.0 / s.frameDivisor, std::min(1.0, 8.0 / double(std::min(w, h))));
-    out.width = still.width = std::max(1, int(std::lround(w * scale)));
-    out.height = still.height = std::max(1, int(std::lround(h * scale)));
+    // The frame divided by frameDivisor, but not below 8 pixels on its short side unless the
+    // frame itself is; its shape kept (a 16 x 12 frame made 8 x 8 widened the view).
+    const int w = base.camera.width, h = base.camera.height, shortSide = std::min(w, h);
+    if (shortSide / s.frameDivisor >= 8) {
+        still.width = w / s.frameDivisor;
+        still.height = h / s.frameDivisor;
+    } else if (shortSide > 8) {
+        still.width = int(std::lround(w * 8.0 / shortSide));
+        still.height = int(std::lround(h * 8.0 / shortSide));
+    }
+    out.width = still.width;
+    out.height = still.height;
     // The camera backs away from its look-at, to dollyEnd times its distance.
     const scenes::Vec3 offset = still.position_cm - still.lookAt_cm;
     std::vector<scenes::Camera> cameras;

@@ -267,7 +267,7 @@ private:
     // The period of a cone's needles in azimuth (radians).
     static double needlePeriod(const TracedBough& b)
     {
-        return 2.0 * analytic::kPi / std::max(1.0, std::round(b.geometry.cone.needlesPerCone));
+        return 2.0 * analytic::kPi / scenes::wholeNeedles(b.geometry.cone.needlesPerCone);
     }
 
     // The arcs of the line from x along d (forEachBandFrom's bands).

@@ -664,10 +664,11 @@ LevelBlend blendLevels(double footprint_cm, double coneSpacing_cm,
     const double q = footprint_cm / coneSpacing_cm;
     const Level level = chooseLevel(footprint_cm, coneSpacing_cm, s);
     LevelBlend out{level, level, 0.0};
-    // Never wider than keeps the two bands apart (the scene parser and the tool refuse or
-    // narrow a wider one; this guards a scene built in code).
+    // Never wider than keeps the two bands apart: the scene parser and the tool refuse or
+    // narrow a wider one, but compare's error budget moves cone_level_max to the paper's with
+    // the scene's band kept, and a scene may be built in code.
     const double coneLevelMax = s.model.coneLevelMax;
-    const double band = std::min(s.model.levelBlend, std::sqrt(coneLevelMax / s.needleLevelMax));
+    const double band = std::min(s.model.levelBlend, s.widestLevelBlend());
     if (!(band > 1.0)) return out;
     for (const auto& [threshold, lower] :
          {std::pair{s.needleLevelMax, Level::Needle}, std::pair{coneLevelMax, Level::Cone}}) {

@@ -140,7 +140,7 @@ struct ModelOverrides {
         // The two bands must not overlap: a band given here too wide for the thresholds is
         // refused, and the scene's (or the default) narrowed to what thresholds moved closer
         // allow, so that the header records the band drawn.
-        const double widest = std::sqrt(m.coneLevelMax / render.needleLevelMax);
+        const double widest = render.widestLevelBlend();
         if (m.levelBlend > widest) {
             if (levelBlend > 0.0) {
                 std::ostringstream message;
@@ -150,6 +150,9 @@ struct ModelOverrides {
                         << render.needleLevelMax;
                 throw InputError(message.str());
             }
+            tool::info() << "vdbtrace: level_blend " << m.levelBlend << " narrowed to " << widest
+                         << " to keep the bands about needle_level_max " << render.needleLevelMax
+                         << " and cone_level_max " << m.coneLevelMax << " apart\n";
             m.levelBlend = widest;
         }
     }

@@ -11,6 +11,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <stdexcept>
@@ -123,6 +124,10 @@ struct RenderSettings {
     /// q < needleLevelMax: level 1, needles resolved; q < model.coneLevelMax: level 2, each
     /// cone a semi-opaque surface; otherwise level 3, the bough a volume.
     double needleLevelMax = 0.25;
+
+    /// The widest model.levelBlend that keeps the bands about the two thresholds apart, so
+    /// that a bough is mixed from two levels at most: sqrt(coneLevelMax / needleLevelMax).
+    double widestLevelBlend() const { return std::sqrt(model.coneLevelMax / needleLevelMax); }
 };
 
 struct Scene {

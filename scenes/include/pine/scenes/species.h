@@ -1,6 +1,8 @@
 // A species: the L-system that grows its branches and the needle parameters of its boughs.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -18,6 +20,13 @@ struct NeedleParameters {
 
 /// Parameters at fraction t in [0, 1] from a to b, each linearly.
 NeedleParameters lerp(const NeedleParameters& a, const NeedleParameters& b, double t);
+
+/// N as needles are drawn: whole needles a cone, at least one. Every method draws a bough with
+/// its middle's N so (bake::boughGeometry), the explicit needles as the closed forms.
+inline double wholeNeedles(double perCone)
+{
+    return std::max(1.0, std::round(perCone));
+}
 
 struct Species {
     // L-system (Prusinkiewicz & Lindenmayer) with a 3D turtle:

@@ -29,8 +29,8 @@ struct Bough {
     /// Cones on the bough: its length over the mean cone spacing. The mean is the logarithmic
     /// one, which makes the count exact when dh varies linearly along the bough.
     double coneCount(double length_cm) const;
-    /// Needles on the bough: N / dh integrated along it (= coneCount * N when N is constant).
-    /// (added)
+    /// Needles on the bough: its cones times its middle's N in whole needles (wholeNeedles),
+    /// as every method draws them (added).
     double needleCount(double length_cm) const;
 };
 

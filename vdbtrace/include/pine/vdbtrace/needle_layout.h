@@ -35,13 +35,18 @@ inline double coneRoll(unsigned seed, long j)
 class NeedleLayout {
 public:
     explicit NeedleLayout(const TracedBough& b)
-        : mBase(b.base_cm), mAxis(b.axis), mE1(analytic::anyPerpendicular(b.axis)),
-          mE2(glm::cross(b.axis, mE1)), mSpacing(b.geometry.coneSpacing_cm),
+        : mBase(b.base_cm),
+          mAxis(b.axis),
+          mE1(analytic::anyPerpendicular(b.axis)),
+          mE2(glm::cross(b.axis, mE1)),
+          mSpacing(b.geometry.coneSpacing_cm),
           mCos(apertureTrig(b.geometry.cone.aperture_rad).cosPhi),
           mSin(apertureTrig(b.geometry.cone.aperture_rad).sinPhi),
-          mLength(b.geometry.cone.needleLength_cm), mRadius(b.geometry.cone.needleRadius_cm),
+          mLength(b.geometry.cone.needleLength_cm),
+          mRadius(b.geometry.cone.needleRadius_cm),
           mLastCone(long(std::floor(b.length_cm / b.geometry.coneSpacing_cm))),
-          mNeedles(std::max(1, int(std::lround(b.geometry.cone.needlesPerCone)))), mSeed(b.seed)
+          mNeedles(int(scenes::wholeNeedles(b.geometry.cone.needlesPerCone))),
+          mSeed(b.seed)
     {
     }
 
