@@ -118,9 +118,12 @@ def plot_trees(directory):
     path = os.path.join(directory, "trees.csv")
     if not os.path.exists(path):
         return
+    # An empty bias is undefined (the tree is black in the truth): no point, and no plot
+    # where no tree has one.
     with open(path, newline="") as fh:
         trees = [r for r in csv.DictReader(fh)
-                 if r["method"] != "truth" and not r["method"].startswith("budget:")]
+                 if r["method"] != "truth" and not r["method"].startswith("budget:")
+                 and r["luminance_bias"]]
     if not trees:
         return
     fig, ax = plt.subplots(figsize=(7.5, 5.0))
@@ -128,11 +131,8 @@ def plot_trees(directory):
     shades = {}
     for key in dict.fromkeys((r["method"], r["setting"]) for r in trees):
         method, setting = key
-        # An empty bias is undefined (the tree is black in the truth).
         points = [(float(r["coverage_px_truth"]), 100.0 * float(r["luminance_bias"]))
-                  for r in trees if (r["method"], r["setting"]) == key and r["luminance_bias"]]
-        if not points:
-            continue
+                  for r in trees if (r["method"], r["setting"]) == key]
         colour, marker, _ = STYLE.get(method, ("black", "x", method))
         shade = shades.get(method, 0)
         shades[method] = shade + 1
