@@ -507,8 +507,10 @@ expect_error "temporal report without a path" 2 "has no camera_path" -- animate-
 expect_error "temporal report of 2 frames" 2 "at least 3 frames" -- animate-compare "$src/scenes/three-firs.json" --frames 1-2 --self-shadowing --out-dir "$work/anim"
 expect_error "temporal report, effects unmatched" 2 "self_shadowing" -- animate-compare "$src/scenes/paper-forest.json" --out-dir "$work/anim"
 "$vdbtrace" animate-compare "$src/scenes/three-firs.json" --frames 2-5 --resolution 32x24 \
-    --self-shadowing --strip 2 --no-plot --truth-samples 4 --out-dir "$work/anim" --quiet ||
+    --self-shadowing --strip 16 --no-plot --truth-samples 4 --out-dir "$work/anim" 2>"$work/err" ||
     fail "animate-compare: exit $?"
+grep -q -- "--strip 16: the strip shows 4 frames, as many as there are" "$work/err" ||
+    fail "a strip of more frames than there are was not said: $(grep -i strip "$work/err")"
 for f in report.md flicker.csv frames.csv strip.png; do
     [ -s "$work/anim/$f" ] || fail "animate-compare wrote no $f"
 done

@@ -244,6 +244,10 @@ AnimationFlicker runAnimationCompare(const AnimationCompareOptions& o)
     // Evenly spaced from the first frame to the last.
     std::vector<int> stripFrames;
     const int stripCount = std::clamp(o.stripFrames, 1, range.count());
+    if (stripCount != o.stripFrames && o.log) {
+        o.log("--strip " + std::to_string(o.stripFrames) + ": the strip shows " +
+              std::to_string(stripCount) + " frames, as many as there are");
+    }
     for (int k = 0; k < stripCount; ++k) {
         stripFrames.push_back(stripCount == 1 ? 0 : k * (range.count() - 1) / (stripCount - 1));
     }
