@@ -87,6 +87,15 @@ void readLSystem(ObjectReader& r, Species& s)
 }
 
 // One end of a bough (section 3.1); keys absent take `fallback`'s values.
+// Section 3.3: A = 2 N r / (pi R) is the fraction of the cone covered by needles; above 1 the
+// needles of one cone overlap and no shader level describes them. N as every method draws it,
+// in whole needles (bake::boughGeometry).
+double layerCoverage(const NeedleParameters& p)
+{
+    return analytic::layerCoverage(
+        analytic::ConeGeometry{p.aperture_rad, p.length_cm, p.radius_cm, wholeNeedles(p.perCone)});
+}
+
 NeedleParameters readNeedles(const Json& value, const Where& where,
                              const NeedleParameters& fallback)
 {
@@ -113,16 +122,27 @@ NeedleParameters readNeedles(const Json& value, const Where& where,
                   formatNumber(2.0 * p.length_cm / kMaxLayersAcross) +
                   " cm): a line through a bough would cross more layers than that");
     }
-    // Section 3.3: A = 2 N r / (pi R) is the fraction of the cone covered by needles; above 1
-    // the needles of one cone overlap and no shader level describes them. N as every method
-    // draws it, in whole needles (bake::boughGeometry).
-    const double A = analytic::layerCoverage(
-        analytic::ConeGeometry{p.aperture_rad, p.length_cm, p.radius_cm, wholeNeedles(p.perCone)});
-    if (A > 1.0) {
+    if (const double A = layerCoverage(p); A > 1.0) {
         where.fail("needles overlap on their cone: A = 2 N r / (pi l sin(phi)) = " +
                    formatNumber(A) + " > 1");
     }
     return p;
+}
+
+// Between base and tip each parameter varies linearly, so A can exceed 1 where it does at
+// neither end (r grows as l shrinks): checked at fine steps along the branch.
+void checkNeedlesAlong(const NeedleParameters& base, const NeedleParameters& tip,
+                       const Where& where)
+{
+    constexpr int kSteps = 64;
+    for (int k = 1; k < kSteps; ++k) {
+        const double t = double(k) / kSteps;
+        if (const double A = layerCoverage(lerp(base, tip, t)); A > 1.0) {
+            where.fail("needles overlap on their cone " + formatNumber(t) +
+                       " of the way from base to tip: A = 2 N r / (pi l sin(phi)) = " +
+                       formatNumber(A) + " > 1");
+        }
+    }
 }
 
 }  // namespace
@@ -146,6 +166,7 @@ Species readSpecies(const Json& value, const Where& where)
             s.needlesAtTip = readNeedles(*tip, n.where().key("tip"), s.needlesAtBase);
         }
         n.finish();
+        checkNeedlesAlong(s.needlesAtBase, s.needlesAtTip, n.where());
     } else {
         s.needlesAtTip = s.needlesAtBase;
     }

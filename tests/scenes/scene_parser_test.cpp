@@ -652,6 +652,15 @@ TEST(SceneParser, RejectsNeedlesThatCannotExist)
     j["species"]["fir"]["needles"]["tip"]["per_cone"] = 11.6;
     expectError(j, "species.fir.needles.tip",
                 "needles overlap on their cone: A = 2 N r / (pi l sin(phi)) = 1.018");
+    // Fine at both ends, overlapping between them: 40 needles of radius 0.05 at the base and 4
+    // of 0.5 at the tip each cover 0.78 of their cone, 22 of 0.275 half way cover 2.4.
+    j = fullScene();
+    j["species"]["fir"]["needles"]["base"] = {
+        {"aperture_deg", 22.5}, {"length", 4.25}, {"radius", 0.05}, {"per_cone", 40}};
+    j["species"]["fir"]["needles"]["tip"] = {
+        {"aperture_deg", 22.5}, {"length", 4.25}, {"radius", 0.5}, {"per_cone", 4}};
+    expectError(j, "species.fir.needles", "needles overlap on their cone 0.");
+    expectError(j, "species.fir.needles", "of the way from base to tip");
     // Cones 1e-6 cm apart: a line through a bough would cross millions of layers.
     j = fullScene();
     j["species"]["fir"]["needles"]["base"]["cone_spacing"] = 1e-6;
