@@ -93,14 +93,6 @@ TreeSample sumTrees(const scenes::Scene& scene, const std::vector<std::size_t>& 
     return total;
 }
 
-std::string count(double n)
-{
-    if (!std::isfinite(n)) return "more than 1e308";
-    char text[64];
-    std::snprintf(text, sizeof text, n < 1e6 ? "%.0f" : "%.3g", n);
-    return text;
-}
-
 std::vector<std::size_t> allTrees(const scenes::Scene& scene)
 {
     std::vector<std::size_t> all(scene.trees.size());
@@ -115,7 +107,7 @@ void addVoxels(ResourceEstimate& e, const TreeSample& trees, double voxelSize_cm
     const double voxels = trees.boughVolume_cm3 / (voxelSize_cm * voxelSize_cm * voxelSize_cm);
     char size[32];
     std::snprintf(size, sizeof size, "%.3g cm", voxelSize_cm);
-    e.parts.push_back({count(voxels) + " voxels of " + size,
+    e.parts.push_back({formatCount(voxels) + " voxels of " + size,
                        voxels * (bytesPerVoxel + kBytesPerVoxelLight * lights)});
 }
 
@@ -159,8 +151,9 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
                        pixels * kBytesPerPixel});
     const TreeSample trees = sumTrees(scene, allTrees(scene));
     const double lights = double(scene.pointLights.size() + scene.directionalLights.size());
-    e.parts.push_back({count(double(scene.trees.size())) + " trees (" + count(trees.boughs) +
-                           " boughs, " + count(trees.branches) + " branches)",
+    e.parts.push_back({formatCount(double(scene.trees.size())) + " trees (" +
+                           formatCount(trees.boughs) + " boughs, " + formatCount(trees.branches) +
+                           " branches)",
                        trees.branches * kBytesPerBranch + trees.boughs * kBytesPerBough});
     // Each variant is grown once, at its first tree, every other tree for itself; all are
     // held until the boughs are made. The reference bakes from every tree, a variant's copies
@@ -185,14 +178,14 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
         const double all = trees.boughs * (kBytesPerBoughView + kBytesPerBoughLight * lights);
         const bool bounded = lawProfileBudget_bytes < all;
         e.parts.push_back({bounded ? "the law profiles, within --law-cache"
-                                   : "the law profiles of up to " + count(trees.boughs) +
+                                   : "the law profiles of up to " + formatCount(trees.boughs) +
                                          " boughs (--law-cache MIB bounds them)",
                            bounded ? lawProfileBudget_bytes : all});
     } else if (method == "geometry") {
         // Instanced, the variants' first trees' needles are the only cylinders laid out.
         const bool shared = copies && instanceVariants;
         const TreeSample own = shared ? grown : trees;
-        e.parts.push_back({count(own.needles) + " needle cylinders" +
+        e.parts.push_back({formatCount(own.needles) + " needle cylinders" +
                                (shared ? " (a variant's trees share them)" : ""),
                            own.needles * kBytesPerNeedle});
     } else if (method == "reference") {
@@ -215,8 +208,9 @@ ResourceEstimate estimateCompare(const scenes::Scene& scene, double smallestVoxe
     }
     const double pixels = double(scene.camera.width) * double(scene.camera.height);
     if (images > 1) {
-        largest.parts.push_back({count(double(images - 1)) + " more images kept for the report",
-                                 double(images - 1) * pixels * kBytesPerPixel});
+        largest.parts.push_back(
+            {formatCount(double(images - 1)) + " more images kept for the report",
+             double(images - 1) * pixels * kBytesPerPixel});
     }
     return largest;
 }
@@ -245,6 +239,14 @@ double defaultMemoryLimit()
 }
 
 double memoryLimit(double gib) { return gib > 0.0 ? gib * kGiB : defaultMemoryLimit(); }
+
+std::string formatCount(double n)
+{
+    if (!std::isfinite(n)) return "more than 1e308";
+    char text[64];
+    std::snprintf(text, sizeof text, n < 1e6 ? "%.0f" : "%.3g", n);
+    return text;
+}
 
 std::string formatBytes(double bytes)
 {

@@ -377,13 +377,11 @@ std::string whyUntraceable(const scenes::Tree& tree, const std::vector<bake::Bou
         const double dh = b.needles.coneSpacing_cm;
         const double cones = length / dh;
         if (!(cones <= kMaxConesPerBough)) {
-            char counted[32];  // whole below a million, then as 1.2e+07
-            std::snprintf(counted, sizeof counted, cones < 1e6 ? "%.0f" : "%.3g", cones);
             std::snprintf(text, sizeof text,
                           "a bough %.4g cm long bears %s cones %.3g cm apart, more than %.0f (its "
                           "species' lsystem.segment, length_decay or cone_spacing, or the tree's "
                           "height)",
-                          length, counted, dh, kMaxConesPerBough);
+                          length, bake::formatCount(cones).c_str(), dh, kMaxConesPerBough);
             return text;
         }
     }

@@ -64,6 +64,9 @@ double defaultMemoryLimit();
 /// --max-memory in GiB as bytes; 0 for defaultMemoryLimit().
 double memoryLimit(double gib);
 
+/// A count in a message: whole below a million, then as "1.2e+07"; "more than 1e308" past any.
+std::string formatCount(double n);
+
 /// "1.5 GiB", "12 MiB", "3 KiB", "1e-291 bytes" (under a GiB rounded up), "an unbounded amount"
 /// (not finite).
 std::string formatBytes(double bytes);
