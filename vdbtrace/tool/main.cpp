@@ -373,11 +373,12 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
     const vdbtrace::RenderMethod& method = vdbtrace::renderMethod(methodName);
     vdbtrace::TracedSceneParts parts = partsWithin(method, lawCacheMiB);
     // The extension decides the format: only EXR holds the render (its PNG goes beside it).
-    std::string extension = out.extension().string();
-    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-    std::string name = out.filename().string();
-    for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (name == ".exr") {  // a hidden file without an extension, to the library
+    const auto lowered = [](std::string text) {
+        for (char& c : text) c = char(std::tolower(static_cast<unsigned char>(c)));
+        return text;
+    };
+    const std::string extension = lowered(out.extension().string());
+    if (lowered(out.filename().string()) == ".exr") {  // hidden, without an extension
         throw InputError("--out '" + out.string() + "': the file needs a name before .exr");
     }
     if (extension != ".exr") {
