@@ -28,6 +28,7 @@
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -406,20 +407,29 @@ TEST(CompareRun, EffectsTheMethodsCannotShareAreRefused)
     EXPECT_NO_THROW(checkEffects(effects));
 }
 
+// A comparison of a few settings, each run once, against a 4 spp truth with no check of it,
+// no budget and no reference.
+CompareSettings fewSettings(std::vector<int> geometrySamples, std::vector<int> levels)
+{
+    CompareSettings st;
+    st.truthSamples = 4;
+    st.truthCheckFactor = 0;
+    st.repeat = 1;
+    st.budget = false;
+    st.geometrySamples = std::move(geometrySamples);
+    st.voxelSizes_cm = {};
+    st.levels = std::move(levels);
+    return st;
+}
+
 // A setting's runs are spread over the comparison: round by round, every setting once a round,
 // in the report's order, the truth once first. Back to back, each setting would be timed in
 // one stretch of a shared machine whose speed drifts, and their ratios would drift with it.
 TEST(CompareRun, EverySettingRunsOnceARoundInTheReportsOrder)
 {
     const scenes::Scene scene = scenes::parseScene(kFirScene, "fir.json");
-    CompareSettings st;
-    st.truthSamples = 4;
-    st.truthCheckFactor = 0;
+    CompareSettings st = fewSettings({1, 2}, {2, 0});
     st.repeat = 3;
-    st.budget = false;
-    st.geometrySamples = {1, 2};
-    st.voxelSizes_cm = {};
-    st.levels = {2, 0};
     std::vector<std::string> runs, rows;
     const CompareRun run = runComparison(scene, st, [&](const std::string& line) {
         if (line.find(" CPU-s") == std::string::npos) return;  // the scene's build, say
@@ -462,14 +472,7 @@ TEST(CompareRun, ABlackTruthHasNoLuminanceBiasInAnyReport)
         black.replace(at, key.size(), key.substr(0, key.find(':')) + ": 0");
     }
     const scenes::Scene scene = scenes::parseScene(black, "fir.json");
-    CompareSettings st;
-    st.truthSamples = 4;
-    st.truthCheckFactor = 0;
-    st.repeat = 1;
-    st.budget = false;
-    st.geometrySamples = {1};
-    st.voxelSizes_cm = {};
-    st.levels = {0};
+    const CompareSettings st = fewSettings({1}, {0});
     const CompareRun run = runComparison(scene, st, {});
     // "nan" as a number prints it, not inside a word ("luminance").
     const auto printsNan = [](const std::string& text) {
