@@ -11,18 +11,20 @@
 #include "pine/support/progress.h"
 #include "pine/support/tool_main.h"
 
-#include <CLI/CLI.hpp>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <memory>
+#include <set>
 #include <vector>
 
 namespace {
@@ -138,6 +140,54 @@ fs::path treeFile(const fs::path& dir, std::size_t index)
     return dir / name;
 }
 
+/// The files an instance list names (each placement's grids, their manifest and its mesh),
+/// read leniently: none from a list that is missing or not one; names that are not bare file
+/// names (a hand-edited "../x.vdb") are skipped, since only the folder's own files are meant.
+std::set<std::string> filesListedIn(const fs::path& listFile)
+{
+    std::set<std::string> names;
+    std::ifstream in(listFile);
+    const nlohmann::json list = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (!list.is_object() || list.value("format", "") != "pine-instances") return names;
+    const auto instances = list.find("instances");
+    if (instances == list.end() || !instances->is_array()) return names;
+    const auto add = [&](const nlohmann::json& name, const char* suffix) {
+        if (!name.is_string()) return;
+        const std::string bare = name.get<std::string>();
+        if (bare.empty() || bare == "." || bare == ".." || fs::path(bare).filename() != bare) {
+            return;
+        }
+        names.insert(bare + suffix);
+    };
+    for (const nlohmann::json& entry : *instances) {
+        if (!entry.is_object()) continue;
+        add(entry.value("grids", nlohmann::json()), "");
+        add(entry.value("grids", nlohmann::json()), ".json");  // the grids' manifest
+        add(entry.value("mesh", nlohmann::json()), "");
+    }
+    return names;
+}
+
+/// Removes from `dir` the files its previous instance list named (`before`) that the new one
+/// does not (`now`): a scene of fewer trees baked over a larger one would otherwise leave
+/// tree_NNN files that nothing lists and `bake verify DIR` reads as sound. Never an input.
+std::size_t removeUnlisted(const fs::path& dir, const std::set<std::string>& before,
+                           const std::set<std::string>& now, const fs::path& sceneFile)
+{
+    std::size_t removed = 0;
+    for (const std::string& name : before) {
+        if (now.count(name) != 0 || io::sameFile(dir / name, sceneFile)) continue;
+        std::error_code error;
+        if (fs::remove(dir / name, error)) {
+            ++removed;
+        } else if (error) {
+            throw InputError("cannot remove '" + (dir / name).string() +
+                             "', left from the folder's previous bake: " + error.message());
+        }
+    }
+    return removed;
+}
+
 int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const std::string& law,
               const Output& output, const fs::path& dir, double maxMemoryGiB)
 {
@@ -160,6 +210,7 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
     // The folder made only once nothing above refuses the run.
     io::checkWritableFolder(dir);
     io::checkWritable(treeFile(dir, 0));
+    const std::set<std::string> listedBefore = filesListedIn(listFile);
     Totals totals;
     std::vector<bake::ProxyInstance> instances(n);
     tool::Progress progress("bake:");
@@ -170,20 +221,35 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
     });
     progress.finish();
     // Last: a list names only files already in place.
-    writeInTurn(listFile,
-                bake::instanceList(sceneFile.string(), output.unit, instances).dump(1) + "\n");
+    const nlohmann::json list = bake::instanceList(sceneFile.string(), output.unit, instances);
+    writeInTurn(listFile, list.dump(1) + "\n");
+    // Then what the previous list named and this one does not: a bake killed before this
+    // point leaves them, but its list (the previous one) still names them.
+    const std::size_t removed =
+        removeUnlisted(dir, listedBefore, filesListedIn(listFile), sceneFile);
+    if (removed > 0) {
+        tool::info() << "bake: removed " << removed << " files of the previous bake in '"
+                     << dir.string() << "' that this scene does not have\n";
+    }
     summarize(totals, start);
     return 0;
 }
 
+/// A .vdb file to verify, and why it is suspect before it is read: a folder's file that the
+/// folder's instances.json does not name (left by another bake, or put there by hand).
+struct FileToVerify {
+    fs::path path;
+    std::string unlisted;
+};
+
 /// The .vdb files among `paths`, a folder standing for the .vdb files in it (sorted).
-std::vector<fs::path> vdbFiles(const std::vector<fs::path>& paths)
+std::vector<FileToVerify> vdbFiles(const std::vector<fs::path>& paths)
 {
-    std::vector<fs::path> files;
+    std::vector<FileToVerify> files;
     for (const fs::path& path : paths) {
         std::error_code error;
         if (!fs::is_directory(path, error)) {
-            files.push_back(path);
+            files.push_back({path, {}});
             continue;
         }
         std::vector<fs::path> inside;
@@ -193,33 +259,43 @@ std::vector<fs::path> vdbFiles(const std::vector<fs::path>& paths)
         }
         if (error) throw InputError("cannot list '" + path.string() + "': " + error.message());
         std::sort(inside.begin(), inside.end());
-        files.insert(files.end(), inside.begin(), inside.end());
+        const fs::path listFile = path / "instances.json";
+        const std::set<std::string> listed = filesListedIn(listFile);
+        for (const fs::path& file : inside) {
+            const bool unlisted = !listed.empty() && listed.count(file.filename().string()) == 0;
+            files.push_back({file, unlisted
+                                       ? "not in " + listFile.string() + ", left by another bake?"
+                                       : std::string()});
+        }
     }
     return files;
 }
 
 /// Reads every file as a render would (manifest, then OpenVDB in a child process): one line
-/// each; status 2 if any is refused, else 3 if any was read without a manifest (unverified).
+/// each; status 2 if any is refused, else 3 if any was read without a manifest or lies in a
+/// baked folder whose instances.json does not name it (unverified).
 int verify(const std::vector<fs::path>& paths, double maxMemoryGiB)
 {
-    const std::vector<fs::path> files = vdbFiles(paths);
+    const std::vector<FileToVerify> files = vdbFiles(paths);
     if (files.empty()) throw InputError("no .vdb files in what was given");
     int refused = 0, unverified = 0;
-    for (const fs::path& file : files) {
+    for (const FileToVerify& file : files) {
         try {
             const bake::ReadGrids read =
-                bake::readTreeGrids(file, bake::memoryLimit(maxMemoryGiB));
+                bake::readTreeGrids(file.path, bake::memoryLimit(maxMemoryGiB));
             const bake::TreeGrids& grids = read.grids;
-            std::cout << file.string() << ": " << (read.unverified.empty() ? "ok" : "unverified")
-                      << ", " << grids.density->activeVoxelCount() << " voxels of "
-                      << grids.voxelSize_cm << " cm, extinction law " << grids.extinctionLaw;
-            if (!read.unverified.empty()) {
-                std::cout << " (" << read.unverified << ")";
+            std::string why = read.unverified;
+            if (!file.unlisted.empty()) why += (why.empty() ? "" : "; ") + file.unlisted;
+            std::cout << file.path.string() << ": " << (why.empty() ? "ok" : "unverified") << ", "
+                      << grids.density->activeVoxelCount() << " voxels of " << grids.voxelSize_cm
+                      << " cm, extinction law " << grids.extinctionLaw;
+            if (!why.empty()) {
+                std::cout << " (" << why << ")";
                 ++unverified;
             }
             std::cout << "\n";
         } catch (const InputError& e) {
-            std::cout << file.string() << ": refused: " << e.what() << "\n";
+            std::cout << file.path.string() << ": refused: " << e.what() << "\n";
             ++refused;
         }
     }
@@ -287,8 +363,10 @@ int main(int argc, char** argv)
 
     std::vector<fs::path> verifyPaths;
     auto* verifyCmd = app.add_subcommand(
-        "verify", "Check baked files as a render reads them (manifest, then OpenVDB isolated); "
-                  "exit status 2 if any is refused, 3 if any has no manifest");
+        "verify",
+        "Check baked files as a render reads them (manifest, then OpenVDB isolated); "
+        "exit status 2 if any is refused, 3 if any has no manifest or is not in its "
+        "folder's instances.json");
     verifyCmd->add_option("paths", verifyPaths, ".vdb files, or folders of them")->required();
     verifyCmd->add_option("--max-memory", maxMemoryGiB,
                           "Memory OpenVDB may use to read one file, in GiB (default: 80% of "

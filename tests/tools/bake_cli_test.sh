@@ -103,8 +103,23 @@ assert [i["grids"] for i in j["instances"]] == ["tree_000.vdb", "tree_001.vdb", 
 assert all(i["mesh"].endswith(".obj") and len(i["tree_to_world"]) == 4 for i in j["instances"]), j
 EOF2
 tail -1 "$work/err" | grep -q "3 trees, .* voxels, .* bytes, .* s, peak .* MiB" || fail "no summary line: $(tail -1 "$work/err")"
+# A scene of fewer trees baked into the same folder removes the files the previous list named
+# and the new one does not; verify calls a tree file the folder's list does not name unverified.
+mkdir "$work/kept" && cp "$work/forest/tree_002.vdb" "$work/forest/tree_002.vdb.json" "$work/kept/"
+"$bake" scene "$bough" --voxel-size 2 --levels 2 --out-dir "$work/forest" 2>"$work/err" \
+    || fail "bake scene of bough.json over three firs failed: $(tail -1 "$work/err")"
+grep -q "removed 6 files of the previous bake in '$work/forest'" "$work/err" || fail "no removal line: $(cat "$work/err")"
+[ "$(ls -A "$work/forest" | tr '\n' ' ')" = "instances.json tree_000.obj tree_000.vdb tree_000.vdb.json " ] \
+    || fail "a smaller scene's bake left: $(ls -A "$work/forest")"
+"$bake" verify "$work/forest" >"$work/out" 2>/dev/null || fail "verify of a rebaked folder: $(cat "$work/out")"
+cp "$work/kept/"* "$work/forest/"
+"$bake" verify "$work/forest" >"$work/out" 2>"$work/err"
+[ $? -eq 3 ] || fail "verify of an unlisted tree file: exit status is not 3: $(cat "$work/out")"
+grep -q "tree_000.vdb: ok, " "$work/out" || fail "verify: $(cat "$work/out")"
+grep -q "tree_002.vdb: unverified, .*(not in $work/forest/instances.json, left by another bake?)$" "$work/out" \
+    || fail "verify of an unlisted tree file: $(cat "$work/out")"
 if command -v vdb_print >/dev/null; then
-    vdb_print "$work/forest/tree_001.vdb" | grep -q "density_level_1" || fail "vdb_print lacks density_level_1"
+    vdb_print "$work/forest/tree_000.vdb" | grep -q "density_level_1" || fail "vdb_print lacks density_level_1"
 fi
 
 "$bake" --help >/dev/null || fail "--help"
