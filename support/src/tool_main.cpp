@@ -8,6 +8,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -123,11 +124,20 @@ std::string shown(double v)
     return s.str();
 }
 
-// Why `text` is not a number `wanted` (one the test `within` accepts), or empty.
+bool spacedAbout(const std::string& text)
+{
+    const auto space = [](unsigned char c) { return std::isspace(c) != 0; };
+    return !text.empty() && (space(text.front()) || space(text.back()));
+}
+
+// Why `text` is not a number `wanted` (one the test `within` accepts), or empty. Spaces about
+// it are refused either side: strtod skips leading ones, so ' 3' was taken where '3 ' was not
+// (CLI11 converts the text as given: a validator under check() cannot trim it).
 std::string whyNotANumber(const std::string& text, const std::string& wanted,
                           const std::function<bool(double)>& within)
 {
     const std::string refused = "must be a number " + wanted + ", got '" + text + "'";
+    if (spacedAbout(text)) return refused + ", with spaces about it";
     errno = 0;
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
@@ -157,13 +167,18 @@ CLI::Validator wholeNumberAtLeast(long least)
 {
     return CLI::Validator(
         [least](std::string& text) -> std::string {
+            const std::string refused =
+                "must be a whole number >= " + std::to_string(least) + ", got '" + text + "'";
+            // stol skips leading spaces and stops at trailing ones: refused both ways, as
+            // whyNotANumber refuses them.
+            if (spacedAbout(text)) return refused + ", with spaces about it";
             try {
                 std::size_t used = 0;
                 const long v = std::stol(text, &used, 0);  // as CLI11 reads it: 010 is 8
                 if (used == text.size() && v >= least) return {};
             } catch (const std::exception&) {
             }
-            return "must be a whole number >= " + std::to_string(least) + ", got '" + text + "'";
+            return refused;
         },
         ">= " + std::to_string(least));
 }

@@ -305,6 +305,11 @@ expect_error "an overflowing number" 2 "--cone-level-max: must be a number > 0, 
     render "$src/scenes/bough.json" --cone-level-max 1e400 --out "$work/n2.exr"
 expect_error "a number with a tail" 2 "--cone-level-max: must be a number > 0, got '3abc'" -- \
     render "$src/scenes/bough.json" --cone-level-max 3abc --out "$work/n2.exr"
+# Spaces about a number are refused either side (a leading one was taken, a trailing one not).
+expect_error "a number after a space" 2 "--cone-level-max: must be a number > 0, got ' 3', with spaces about it" -- \
+    render "$src/scenes/bough.json" --cone-level-max " 3" --out "$work/n2.exr"
+expect_error "a whole number before a space" 2 "--threads: must be a whole number >= 0, got '2 ', with spaces about it" -- \
+    render "$src/scenes/bough.json" --threads "2 " --out "$work/n2.exr"
 expect_error "a band too wide for the thresholds" 2 "--level-blend 2 must be at most sqrt(cone_level_max / needle_level_max) (1.09545) for cone_level_max 0.3" -- \
     render "$src/scenes/bough.json" --level-blend 2 --cone-level-max 0.3 --out "$work/n2.exr"
 grep -q '"layer_correlation": "needles"' "$work/b.json" || fail "default layer correlation not recorded as needles"
