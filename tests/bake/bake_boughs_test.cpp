@@ -1,5 +1,5 @@
-// Voxelized boughs against the continuous field: mass, values at voxel centres, the overlap
-// rule, the density pyramid.
+// Voxelized boughs against the continuous field: mass, values at voxel centres, overlapping
+// boughs, the density pyramid.
 #include "pine/bake/extinction_law.h"
 #include "pine/bake/tree_grids.h"
 
@@ -8,7 +8,10 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include <tbb/task_arena.h>
+
 #include <cmath>
+#include <vector>
 
 namespace pine::bake {
 namespace {
@@ -170,11 +173,14 @@ TEST(BakeBoughs, EveryVoxelSamplesTheFieldAtItsCentre)
     EXPECT_GT(inside, 1000);
 }
 
-TEST(BakeBoughs, OverlapKeepsTheDensestBoughWhateverTheOrder)
+TEST(BakeBoughs, OverlappingBoughsAddTheirExtinctionWhateverTheOrder)
 {
     // Two boughs crossing at right angles, the second denser (more needles per cone): where
-    // both reach, the voxel holds the denser one, whichever is listed first. Under the layer
-    // law a bough's extinction is uniform, so the denser is the same everywhere.
+    // both reach, both boughs' needles are there, so the density is the sum of their mean
+    // extinctions, and the layered fields are the denser bough's (its albedo, its layers with
+    // the gradient scaled to that sum), whichever is listed first. Under the layer law a
+    // bough's extinction is uniform, so the denser is the same everywhere. The voxelized mass
+    // of the two is the sum of each one's alone.
     const BoughSpec thin = test::paperBough(Vec3(-8.0, 0.0, 0.0), Vec3(1, 0, 0), 16.0);
     BoughSpec dense = test::paperBough(Vec3(0.0, -8.0, 0.3), Vec3(0, 1, 0), 16.0);
     dense.needles.cone.needlesPerCone = 24;
@@ -182,25 +188,67 @@ TEST(BakeBoughs, OverlapKeepsTheDensestBoughWhateverTheOrder)
     const BakeSettings settings{0.3, 1, "layer"};
     const TreeGrids ab = bakeBoughs({thin, dense}, settings);
     const TreeGrids ba = bakeBoughs({dense, thin}, settings);
+    const double alone =
+        voxelizedMass(bakeBoughs({thin}, settings)) + voxelizedMass(bakeBoughs({dense}, settings));
+    EXPECT_NEAR(voxelizedMass(ab), alone, 1e-6 * alone);
     ASSERT_EQ(ab.density->activeVoxelCount(), ba.density->activeVoxelCount());
     auto a = ab.needleAlbedo->getConstAccessor();
     auto b = ba.needleAlbedo->getConstAccessor();
     auto da = ab.density->getConstAccessor();
     auto db = ba.density->getConstAccessor();
+    auto gradient = ab.layerGradient->getConstAccessor();
     int overlap = 0;
     for (auto it = ab.density->cbeginValueOn(); it; ++it) {
         const openvdb::Coord ijk = it.getCoord();
         const openvdb::Vec3d w = ab.density->indexToWorld(ijk);
         const Vec3 x(w.x(), w.y(), w.z());
-        const bool both = sampleBough(thin, x) && sampleBough(dense, x);
-        overlap += both;
+        const auto sThin = sampleBough(thin, x), sDense = sampleBough(dense, x);
         EXPECT_EQ(da.getValue(ijk), db.getValue(ijk)) << ijk;
         EXPECT_EQ(a.getValue(ijk), b.getValue(ijk)) << ijk;
-        if (both) {
-            EXPECT_EQ(a.getValue(ijk), openvdb::Vec3s(0.5f)) << ijk;
-        }
+        if (!sThin || !sDense) continue;
+        ++overlap;
+        const double sum = layerLaw().meanExtinction(*sThin) + layerLaw().meanExtinction(*sDense);
+        EXPECT_NEAR(da.getValue(ijk), sum, 1e-6 * sum) << ijk;
+        EXPECT_EQ(a.getValue(ijk), openvdb::Vec3s(0.5f)) << ijk;
+        // The dense bough's layers, as many more per cm as the thin one's extinction adds.
+        const Vec3 scaled = sDense->gradient * (sum / layerLaw().meanExtinction(*sDense));
+        const openvdb::Vec3s g = gradient.getValue(ijk);
+        EXPECT_NEAR(g.x(), scaled.x, 1e-5 * glm::length(scaled)) << ijk;
+        EXPECT_NEAR(g.y(), scaled.y, 1e-5 * glm::length(scaled)) << ijk;
+        EXPECT_NEAR(g.z(), scaled.z, 1e-5 * glm::length(scaled)) << ijk;
     }
     EXPECT_GT(overlap, 50);
+}
+
+TEST(BakeBoughs, TheGridsDoNotDependOnTheThreads)
+{
+    // Boughs crossing in a star, several in most voxels: their sums are added in an order set
+    // by the boughs alone, so every arena bakes the same bits.
+    std::vector<BoughSpec> star;
+    for (int i = 0; i < 40; ++i) {
+        const double a = 0.157 * i, b = 0.31 * i;
+        const Vec3 axis(std::cos(a) * std::cos(b), std::sin(a) * std::cos(b), std::sin(b));
+        star.push_back(test::paperBough(-6.0 * axis + Vec3(0.01 * i), axis, 12.0));
+    }
+    const BakeSettings settings{0.2, 1, "fibre"};
+    const auto bakeWith = [&](int threads) {
+        tbb::task_arena arena(threads);
+        return arena.execute([&] { return bakeBoughs(star, settings); });
+    };
+    const TreeGrids one = bakeWith(1);
+    for (const int threads : {2, 3, 7}) {
+        const TreeGrids many = bakeWith(threads);
+        ASSERT_EQ(one.density->activeVoxelCount(), many.density->activeVoxelCount());
+        auto d = many.density->getConstAccessor();
+        auto g = many.layerGradient->getConstAccessor();
+        auto og = one.layerGradient->getConstAccessor();
+        int differ = 0;
+        for (auto it = one.density->cbeginValueOn(); it; ++it) {
+            differ += *it != d.getValue(it.getCoord()) ||
+                      og.getValue(it.getCoord()) != g.getValue(it.getCoord());
+        }
+        EXPECT_EQ(differ, 0) << threads << " threads";
+    }
 }
 
 TEST(BakeBoughs, PyramidLevelsAverageTheirChildrenAndKeepTheMass)

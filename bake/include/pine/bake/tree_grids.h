@@ -79,8 +79,9 @@ struct BakeSettings {
 };
 
 /// A tree's grids in world space (cm), all on one transform of voxel size h, voxels sampled at
-/// their centres. Where several boughs overlap a voxel keeps the one of largest mean
-/// extinction; density is that mean extinction, per cm.
+/// their centres. Density is the mean extinction, per cm, summed over the boughs that overlap
+/// a voxel; the other fields are the densest of them, its layer gradient scaled so that its
+/// extinction is that sum.
 struct TreeGrids {
     openvdb::FloatGrid::Ptr density;
     openvdb::Vec3SGrid::Ptr layerGradient;
