@@ -9,9 +9,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <unordered_set>
+#include <vector>
 
 namespace pine::bake {
 namespace {
@@ -39,40 +42,60 @@ constexpr double kBytesPerGrownBough = 165.0;
 // kShadowColumnsMax_bytes.
 constexpr double kBytesPerColumnPrimitive = 64.0;
 constexpr double kBytesPerNeedle = 140.0;
-// A voxel: 84 until the bake summed overlapping boughs (2026-12-06: the paper forest's
-// reference at 0.5 cm peaked at 3.44 GB where it had at 3.20).
-constexpr double kBytesPerVoxel = 90.0, kBytesPerVoxelLight = 8.0;
+// A voxel's place in a leaf (OpenVDB allocates a leaf's 8^3 values whole, and a thin bough fills
+// few of them: the paper forest's leaves hold 101 voxels at 0.5 cm, 55 at 1 cm, 33 at 2 cm):
+// the six grids (48 bytes), the bake's keys and sums (12), each light's grid (8). Measured
+// 2026-12-06, the paper forest's reference peaked at 0.90 GB at 1 cm and 3.44 GB at 0.5 cm
+// (23,375 and 102,785 leaves), about 30 KB a leaf beside the rest; counting voxels as if
+// they filled their leaves had estimated 0.43 and 1.9 GiB.
+constexpr double kBytesPerVoxel = 60.0, kBytesPerVoxelLight = 8.0;
 // A bake written in metres or in a tree's frame converts a copy of every grid while writing
 // (measured: 275 against 164 MiB on a 600k-voxel tree).
-constexpr double kBytesPerVoxelWritten = 190.0;
+constexpr double kBytesPerVoxelWritten = 60.0;
+constexpr double kVoxelsPerLeaf = 512.0;
 constexpr double kProgramBytes = 185.0 * 1024 * 1024;  // its libraries, before any scene
 constexpr const char* kProgram = "the program";
 
-using TreeSample = TreeTotals;  // of one grown tree per species
+using TreeSample = TreeTotals;
 
-TreeSample sampleTree(const scenes::Scene& scene, const scenes::TreePlacement& placement)
+/// The cylinder a bough's cones fill: from its base along its axis for its length and the
+/// cones' reach l cos(phi), radius l sin(phi).
+struct BoughCylinder {
+    Vec3 base, axis;
+    double extent_cm, radius_cm;
+};
+
+/// One grown tree of a species: its totals, and its boughs' cylinders for the voxels' leaves.
+struct SpeciesSample {
+    TreeSample totals;
+    std::vector<BoughCylinder> boughs;
+};
+
+SpeciesSample sampleTree(const scenes::Scene& scene, const scenes::TreePlacement& placement)
 {
     const scenes::Tree tree = scenes::growTree(scene.species.at(placement.species), placement);
     const scenes::TreeCounts counts = tree.counts();
-    TreeSample s;
-    s.branches = double(tree.segments.size());
-    s.boughs = double(counts.boughs);
-    s.needles = counts.needles;
+    SpeciesSample s;
+    s.totals.branches = double(tree.segments.size());
+    s.totals.boughs = double(counts.boughs);
+    s.totals.needles = counts.needles;
     for (const BoughSpec& b : treeBoughs(tree)) {
         const analytic::ConeGeometry& c = b.needles.cone;
         const double R = analytic::boughRadius(c);  // l sin(phi)
         const double length = glm::length(b.tip_cm - b.base_cm);
-        s.boughVolume_cm3 +=
-            kPi * R * R * (length + c.needleLength_cm * std::cos(c.aperture_rad));
+        const double extent = length + c.needleLength_cm * std::cos(c.aperture_rad);
+        s.totals.boughVolume_cm3 += kPi * R * R * extent;
+        if (length > 0.0)
+            s.boughs.push_back({b.base_cm, (b.tip_cm - b.base_cm) / length, extent, R});
     }
     return s;
 }
 
 // One sample per species among the trees of `indices`: its first placement there.
-std::map<std::string, TreeSample> samples(const scenes::Scene& scene,
-                                          const std::vector<std::size_t>& indices)
+std::map<std::string, SpeciesSample> samples(const scenes::Scene& scene,
+                                             const std::vector<std::size_t>& indices)
 {
-    std::map<std::string, TreeSample> bySpecies;
+    std::map<std::string, SpeciesSample> bySpecies;
     for (const std::size_t i : indices) {
         const scenes::TreePlacement& p = scene.trees.at(i);
         if (!bySpecies.count(p.species)) bySpecies.emplace(p.species, sampleTree(scene, p));
@@ -80,13 +103,59 @@ std::map<std::string, TreeSample> samples(const scenes::Scene& scene,
     return bySpecies;
 }
 
+/// The OpenVDB leaves (8^3 voxels of h cm) a tree's boughs reach: points at most a quarter of
+/// a leaf apart through each bough's cylinder, each leaf counted once however many boughs
+/// share it. Where leaves are small against the boughs (more than kMostPoints points), the
+/// boughs' volume fills them: its voxels over a leaf's, a quarter more for the leaves its
+/// surface cuts.
+double leavesOf(const SpeciesSample& tree, double h)
+{
+    constexpr double kMostPoints = 4e6;
+    const double leaf = 8.0 * h, step = 0.25 * leaf;
+    const double filled = tree.totals.boughVolume_cm3 / (leaf * leaf * leaf);
+    // Points across and along a bough: each centred in one of n equal cells at most a step wide.
+    const auto cells = [step](double width) { return std::max(1.0, std::ceil(width / step)); };
+    double points = 0.0;
+    for (const BoughCylinder& b : tree.boughs) {
+        points += cells(b.extent_cm) * cells(2.0 * b.radius_cm) * cells(2.0 * b.radius_cm);
+    }
+    if (!(points <= kMostPoints)) return 1.25 * filled;
+    struct Hash {
+        std::size_t operator()(const std::array<long long, 3>& c) const
+        {
+            return std::size_t(c[0] * 73856093LL ^ c[1] * 19349663LL ^ c[2] * 83492791LL);
+        }
+    };
+    std::unordered_set<std::array<long long, 3>, Hash> leaves;
+    for (const BoughCylinder& b : tree.boughs) {
+        const Vec3 helper = std::abs(b.axis.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+        const Vec3 u = glm::normalize(glm::cross(b.axis, helper)), v = glm::cross(b.axis, u);
+        const int along = int(cells(b.extent_cm)), across = int(cells(2.0 * b.radius_cm));
+        const auto at = [](int i, int n) { return (i + 0.5) / n; };  // in (0, 1)
+        for (int i = 0; i < along; ++i) {
+            const Vec3 centre = b.base + b.extent_cm * at(i, along) * b.axis;
+            for (int j = 0; j < across; ++j) {
+                for (int k = 0; k < across; ++k) {
+                    const double x = b.radius_cm * (2.0 * at(j, across) - 1.0),
+                                 y = b.radius_cm * (2.0 * at(k, across) - 1.0);
+                    if (x * x + y * y > b.radius_cm * b.radius_cm) continue;
+                    const Vec3 p = (centre + x * u + y * v) / leaf;
+                    leaves.insert({(long long)std::floor(p.x), (long long)std::floor(p.y),
+                                   (long long)std::floor(p.z)});
+                }
+            }
+        }
+    }
+    return std::max(double(leaves.size()), filled);
+}
+
 // The trees of `indices`, each counted as its species' sample.
 TreeSample sumTrees(const scenes::Scene& scene, const std::vector<std::size_t>& indices)
 {
-    const std::map<std::string, TreeSample> bySpecies = samples(scene, indices);
+    const std::map<std::string, SpeciesSample> bySpecies = samples(scene, indices);
     TreeSample total;
     for (const std::size_t i : indices) {
-        const TreeSample& one = bySpecies.at(scene.trees[i].species);
+        const TreeSample& one = bySpecies.at(scene.trees[i].species).totals;
         total.branches += one.branches;
         total.boughs += one.boughs;
         total.needles += one.needles;
@@ -102,15 +171,38 @@ std::vector<std::size_t> allTrees(const scenes::Scene& scene)
     return all;
 }
 
-void addVoxels(ResourceEstimate& e, const TreeSample& trees, double voxelSize_cm, double lights,
-               double bytesPerVoxel = kBytesPerVoxel)
+/// Trees like `sample`, `count` of them.
+struct SampledTrees {
+    const SpeciesSample* sample;
+    double count;
+};
+
+/// The voxels of `trees` at `voxelSize_cm`, as OpenVDB holds them: in whole leaves.
+void addVoxels(ResourceEstimate& e, const std::vector<SampledTrees>& trees, double voxelSize_cm,
+               double lights, double bytesPerVoxel = kBytesPerVoxel)
 {
     if (!(voxelSize_cm > 0.0)) return;
-    const double voxels = trees.boughVolume_cm3 / (voxelSize_cm * voxelSize_cm * voxelSize_cm);
+    double voxels = 0.0, leaves = 0.0;
+    for (const SampledTrees& t : trees) {
+        voxels += t.count * t.sample->totals.boughVolume_cm3 / std::pow(voxelSize_cm, 3);
+        leaves += t.count * leavesOf(*t.sample, voxelSize_cm);
+    }
     char size[32];
     std::snprintf(size, sizeof size, "%.3g cm", voxelSize_cm);
     e.parts.push_back({formatCount(voxels) + " voxels of " + size,
-                       voxels * (bytesPerVoxel + kBytesPerVoxelLight * lights)});
+                       leaves * kVoxelsPerLeaf * (bytesPerVoxel + kBytesPerVoxelLight * lights)});
+}
+
+/// Every tree of `indices` as its species' sample.
+std::vector<SampledTrees> sampledTrees(const std::map<std::string, SpeciesSample>& bySpecies,
+                                       const scenes::Scene& scene,
+                                       const std::vector<std::size_t>& indices)
+{
+    std::map<std::string, double> count;
+    for (const std::size_t i : indices) count[scene.trees[i].species] += 1.0;
+    std::vector<SampledTrees> trees;
+    for (const auto& [species, n] : count) trees.push_back({&bySpecies.at(species), n});
+    return trees;
 }
 
 }  // namespace
@@ -194,7 +286,9 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
         if (voxelsRead > 0.0) {
             e.parts.push_back({"light grids", voxelsRead * kBytesPerVoxelLight * lights});
         } else {
-            addVoxels(e, trees, voxelSize_cm, lights);
+            const std::vector<std::size_t> all = allTrees(scene);
+            const std::map<std::string, SpeciesSample> bySpecies = samples(scene, all);
+            addVoxels(e, sampledTrees(bySpecies, scene, all), voxelSize_cm, lights);
         }
     }
     return e;
@@ -223,13 +317,16 @@ ResourceEstimate estimateBake(const scenes::Scene& scene, const std::vector<std:
     ResourceEstimate e;
     e.parts.push_back({kProgram, kProgramBytes});
     // The largest tree, as many times as trees are baked at once.
-    TreeSample largest;
-    for (const auto& [species, one] : samples(scene, trees)) {
-        if (one.boughVolume_cm3 > largest.boughVolume_cm3) largest = one;
+    const std::map<std::string, SpeciesSample> bySpecies = samples(scene, trees);
+    const SpeciesSample* largest = nullptr;
+    for (const auto& [species, one] : bySpecies) {
+        if (!largest || one.totals.boughVolume_cm3 > largest->totals.boughVolume_cm3) {
+            largest = &one;
+        }
     }
+    if (largest == nullptr) return e;
     const double copies = double(std::max<std::size_t>(1, std::min(concurrent, trees.size())));
-    largest.boughVolume_cm3 *= copies;
-    addVoxels(e, largest, voxelSize_cm, 0.0, kBytesPerVoxel + kBytesPerVoxelWritten);
+    addVoxels(e, {{largest, copies}}, voxelSize_cm, 0.0, kBytesPerVoxel + kBytesPerVoxelWritten);
     return e;
 }
 

@@ -39,7 +39,8 @@ TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size
 /// will need, within a factor of about 1.5 of the peaks measured (docs/vdbtrace.md): the image
 /// and its outputs, the trees as the tracer holds them, and the method's own (the multiscale
 /// law profiles of every bough, or `lawProfileBudget_bytes` if less; the grown trees and the
-/// explicit needles; the reference's voxels of `voxelSize_cm` with the light reaching each, or
+/// explicit needles; the reference's voxels of `voxelSize_cm` with the light reaching each,
+/// counted in the OpenVDB leaves that hold them (8^3 voxels allocated whole), or
 /// with `voxelsRead` > 0, grids already read, only that light). Each species is grown once,
 /// for its first placement, which stands for all of its placements.
 /// With `instanceVariants` (the geometry method with Embree's curves), the needles of a
