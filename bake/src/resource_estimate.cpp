@@ -5,12 +5,14 @@
 #include "pine/scenes/tree.h"
 #include "pine/support/input_error.h"
 
-#include <glm/geometric.hpp>
 #include <unistd.h>
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <unordered_set>
@@ -85,8 +87,9 @@ SpeciesSample sampleTree(const scenes::Scene& scene, const scenes::TreePlacement
         const double length = glm::length(b.tip_cm - b.base_cm);
         const double extent = length + c.needleLength_cm * std::cos(c.aperture_rad);
         s.totals.boughVolume_cm3 += kPi * R * R * extent;
-        if (length > 0.0)
+        if (length > 0.0) {
             s.boughs.push_back({b.base_cm, (b.tip_cm - b.base_cm) / length, extent, R});
+        }
     }
     return s;
 }
@@ -123,10 +126,14 @@ double leavesOf(const SpeciesSample& tree, double h)
     struct Hash {
         std::size_t operator()(const std::array<long long, 3>& c) const
         {
-            return std::size_t(c[0] * 73856093LL ^ c[1] * 19349663LL ^ c[2] * 83492791LL);
+            // Unsigned, so that the products wrap rather than overflow.
+            return std::size_t(std::uint64_t(c[0]) * 73856093u ^ std::uint64_t(c[1]) * 19349663u ^
+                               std::uint64_t(c[2]) * 83492791u);
         }
     };
     std::unordered_set<std::array<long long, 3>, Hash> leaves;
+    // A leaf index a long long cannot hold (tiny leaves far out) falls back to the volume.
+    constexpr double kMostIndex = 1e18;
     for (const BoughCylinder& b : tree.boughs) {
         const Vec3 helper = std::abs(b.axis.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
         const Vec3 u = glm::normalize(glm::cross(b.axis, helper)), v = glm::cross(b.axis, u);
@@ -139,9 +146,12 @@ double leavesOf(const SpeciesSample& tree, double h)
                     const double x = b.radius_cm * (2.0 * at(j, across) - 1.0),
                                  y = b.radius_cm * (2.0 * at(k, across) - 1.0);
                     if (x * x + y * y > b.radius_cm * b.radius_cm) continue;
-                    const Vec3 p = (centre + x * u + y * v) / leaf;
-                    leaves.insert({(long long)std::floor(p.x), (long long)std::floor(p.y),
-                                   (long long)std::floor(p.z)});
+                    const Vec3 p = glm::floor((centre + x * u + y * v) / leaf);
+                    if (!(std::abs(p.x) < kMostIndex && std::abs(p.y) < kMostIndex &&
+                          std::abs(p.z) < kMostIndex)) {
+                        return 1.25 * filled;
+                    }
+                    leaves.insert({(long long)p.x, (long long)p.y, (long long)p.z});
                 }
             }
         }
