@@ -1,5 +1,6 @@
 #include "pine/bake/tree_grids.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace pine::bake {
@@ -29,6 +30,41 @@ void fillInactive(const FieldInfo& info, const TreeGrids& into, const TreeGrids&
     }
 }
 
+/// Where `from` and the trees before it (`occupied`) both hold a voxel, their needles are all
+/// there, as where one tree's boughs overlap (bakeBoughs): the densities add, and the layered
+/// fields are the denser tree's there, its layer gradient scaled by the sum over its own.
+void addOverlaps(const TreeGrids& into, const TreeGrids& from, const openvdb::FloatGrid& occupied)
+{
+    auto density = into.density->getAccessor();
+    auto gradient = into.layerGradient->getAccessor();
+    auto opacity = into.layerOpacity->getAccessor();
+    auto needle = into.needleDirection->getAccessor();
+    auto coverage = into.needleCoverage->getAccessor();
+    auto albedo = into.needleAlbedo->getAccessor();
+    const auto taken = occupied.getConstAccessor();
+    const auto theirGradient = from.layerGradient->getConstAccessor();
+    const auto theirOpacity = from.layerOpacity->getConstAccessor();
+    const auto theirNeedle = from.needleDirection->getConstAccessor();
+    const auto theirCoverage = from.needleCoverage->getConstAccessor();
+    const auto theirAlbedo = from.needleAlbedo->getConstAccessor();
+    for (auto it = from.density->cbeginValueOn(); it; ++it) {
+        if (!it.isVoxelValue()) continue;
+        const openvdb::Coord c = it.getCoord();
+        if (!taken.isValueOn(c)) continue;
+        const float mine = density.getValue(c), theirs = *it, sum = mine + theirs;
+        if (theirs > mine) {
+            gradient.setValue(c, theirGradient.getValue(c));
+            opacity.setValue(c, theirOpacity.getValue(c));
+            needle.setValue(c, theirNeedle.getValue(c));
+            coverage.setValue(c, theirCoverage.getValue(c));
+            albedo.setValue(c, theirAlbedo.getValue(c));
+        }
+        const float kept = std::max(mine, theirs);
+        if (kept > 0.0f) gradient.setValue(c, gradient.getValue(c) * (sum / kept));
+        density.setValue(c, sum);
+    }
+}
+
 }  // namespace
 
 TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
@@ -53,8 +89,9 @@ TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
                             "' and '" + t.extinctionLaw + "'");
         }
         // What the trees before this one occupy, fixed while the fields are filled.
-        const openvdb::FloatGrid::Ptr occupied = out.layerOpacity->deepCopy();
+        const openvdb::FloatGrid::Ptr occupied = out.density->deepCopy();
         for (const FieldInfo& info : kFields) fillInactive(info, out, t, *occupied);
+        addOverlaps(out, t, *occupied);
     }
     return out;
 }

@@ -220,6 +220,33 @@ TEST(BakeBoughs, OverlappingBoughsAddTheirExtinctionWhateverTheOrder)
     EXPECT_GT(overlap, 50);
 }
 
+TEST(BakeBoughs, TreesMergedOverlapAsTheirBoughsBakedTogetherDo)
+{
+    // Two crossing boughs, each baked as a tree of its own and merged (a render's --grids), or
+    // baked together (a render's own bake): the same voxels, densities and fields.
+    const BoughSpec thin = test::paperBough(Vec3(-8.0, 0.0, 0.0), Vec3(1, 0, 0), 16.0);
+    BoughSpec dense = test::paperBough(Vec3(0.0, -8.0, 0.3), Vec3(0, 1, 0), 16.0);
+    dense.needles.cone.needlesPerCone = 24;
+    dense.needleAlbedo = Vec3(0.5);
+    const BakeSettings settings{0.3, 1, "layer"};
+    const TreeGrids together = bakeBoughs({thin, dense}, settings);
+    const TreeGrids merged =
+        mergeTreeGrids({bakeBoughs({thin}, settings), bakeBoughs({dense}, settings)});
+    ASSERT_EQ(merged.density->activeVoxelCount(), together.density->activeVoxelCount());
+    auto d = merged.density->getConstAccessor();
+    auto g = merged.layerGradient->getConstAccessor();
+    auto tg = together.layerGradient->getConstAccessor();
+    auto a = merged.needleAlbedo->getConstAccessor();
+    auto ta = together.needleAlbedo->getConstAccessor();
+    for (auto it = together.density->cbeginValueOn(); it; ++it) {
+        const openvdb::Coord c = it.getCoord();
+        ASSERT_NEAR(d.getValue(c), *it, 1e-6f * *it) << c;
+        ASSERT_TRUE((g.getValue(c) - tg.getValue(c)).length() <= 1e-5f * tg.getValue(c).length())
+            << c;
+        ASSERT_EQ(a.getValue(c), ta.getValue(c)) << c;
+    }
+}
+
 TEST(BakeBoughs, TheGridsDoNotDependOnTheThreads)
 {
     // Boughs crossing in a star, several in most voxels: their sums are added in an order set

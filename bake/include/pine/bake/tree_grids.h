@@ -186,8 +186,11 @@ ReadGrids readTreeGrids(const std::filesystem::path& path, double maxMemoryBytes
 namespace pine::bake {
 
 /// The grids of several trees as one set (what a renderer marches through): all must share a
-/// voxel size (BakeError otherwise); where two overlap, the first keeps the voxel, as within a
-/// tree. The density pyramid is not merged.
+/// voxel size (BakeError otherwise); where two overlap, their densities add and the denser
+/// tree's layered fields stay, scaled to the sum, as overlapping boughs within a tree do. So
+/// the same trees baked as one set have the same density (to float rounding), and the same
+/// fields wherever crowns do not overlap; where they do, the fields are the denser tree's,
+/// not the densest bough's. The density pyramid is not merged.
 TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees);
 
 }  // namespace pine::bake
