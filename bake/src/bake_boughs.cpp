@@ -24,8 +24,8 @@ namespace {
 
 using detail::PreparedBough;
 
-/// Which bough a voxel keeps, as one integer so that per-thread grids merge by a plain max
-/// (tools::compMax) and the result does not depend on how boughs were split among threads:
+/// Which bough a voxel keeps, as one integer so that the runs' grids merge by a plain max
+/// (tools::compMax) and the result does not depend on how boughs were split among them:
 /// the larger mean extinction wins (high word: the float's bits, ordered as the floats are for
 /// positive values), and of equal ones the bough listed first (low word: ~index).
 std::int64_t voxelKey(double meanExtinction, std::size_t bough)
@@ -131,8 +131,8 @@ struct VoxelKeys {
 /// pairs, (0, 1), (2, 3), ..., and again, to one. The runs depend on the boughs alone, not on
 /// the threads, so the sums are added in the same order on every machine (floating-point
 /// addition is not associative). Few runs, since each holds leaves of its own: 1,650 runs of
-/// 16 boughs took the paper forest's reference at 0.5 cm to 4.4 GB, 16 runs to 3.4 (3.2 GB
-/// before the sums).
+/// 16 boughs took the paper forest's reference at 0.5 cm to 4.1 GiB, 16 runs to 3.3 (3.0
+/// GiB before the sums); and a bake of one tree runs on at most 16 threads here.
 VoxelKeys voxelKeys(const std::vector<PreparedBough>& boughs, const ExtinctionLaw& law, double h)
 {
     constexpr std::size_t kRuns = 16;
@@ -223,7 +223,9 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
     // so a chain's boughs do not overlap): the density is their summed mean extinction, and the
     // layered fields, which hold one bough's layers, are the densest bough's with its layer
     // gradient scaled by the sum over its own mean. Every law is linear in |layer_gradient|
-    // (layers per cm), so the reference meets as much extinction there as the sum.
+    // (layers per cm), so the reference meets the summed mean extinction there; per direction
+    // it keeps the densest bough's anisotropy (its needles' and layers' directions), and under
+    // the banded law each band meets as many needles, the bands being more.
     auto density = out.density->getAccessor();
     auto gradient = out.layerGradient->getAccessor();
     auto opacity = out.layerOpacity->getAccessor();

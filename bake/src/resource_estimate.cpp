@@ -47,12 +47,14 @@ constexpr double kBytesPerNeedle = 140.0;
 // A voxel's place in a leaf (OpenVDB allocates a leaf's 8^3 values whole, and a thin bough fills
 // few of them: the paper forest's leaves hold 101 voxels at 0.5 cm, 55 at 1 cm, 33 at 2 cm):
 // the six grids (48 bytes), the bake's keys and sums (12), each light's grid (8). Measured
-// 2026-12-06, the paper forest's reference peaked at 0.90 GB at 1 cm and 3.44 GB at 0.5 cm
+// 2026-12-06, the paper forest's reference peaked at 876 MiB at 1 cm and 3.3 GiB at 0.5 cm
 // (23,375 and 102,785 leaves), about 30 KB a leaf beside the rest; counting voxels as if
-// they filled their leaves had estimated 0.43 and 1.9 GiB.
+// they filled their leaves had estimated 426 MiB and 1.9 GiB.
 constexpr double kBytesPerVoxel = 60.0, kBytesPerVoxelLight = 8.0;
-// A bake written in metres or in a tree's frame converts a copy of every grid while writing
-// (measured: 275 against 164 MiB on a 600k-voxel tree).
+// A bake written in metres or in a tree's frame converts a copy of every grid while writing:
+// the grids' 48 bytes a voxel and the density levels, 60 in all. Measured (bake, 2 cores):
+// the paper forest at 0.25 cm peaked at 741 MiB, estimated 859; one fir at 0.125 cm 1.6 GiB,
+// estimated 2.0.
 constexpr double kBytesPerVoxelWritten = 60.0;
 constexpr double kVoxelsPerLeaf = 512.0;
 constexpr double kProgramBytes = 185.0 * 1024 * 1024;  // its libraries, before any scene
@@ -87,7 +89,8 @@ SpeciesSample sampleTree(const scenes::Scene& scene, const scenes::TreePlacement
         const double length = glm::length(b.tip_cm - b.base_cm);
         const double extent = length + c.needleLength_cm * std::cos(c.aperture_rad);
         s.totals.boughVolume_cm3 += kPi * R * R * extent;
-        if (length > 0.0) {
+        // The boughs the bake leaves empty (bake/src/layer_field.cpp) fill no leaf.
+        if (length > 0.0 && R > 0.0 && analytic::layerCoverage(c) > 0.0) {
             s.boughs.push_back({b.base_cm, (b.tip_cm - b.base_cm) / length, extent, R});
         }
     }

@@ -24,6 +24,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -140,20 +141,31 @@ fs::path treeFile(const fs::path& dir, std::size_t index)
     return dir / name;
 }
 
-/// The files an instance list names (each placement's grids, their manifest and its mesh),
-/// read leniently: none from a list that is missing or not one; names that are not bare file
-/// names (a hand-edited "../x.vdb") are skipped, since only the folder's own files are meant.
-std::set<std::string> filesListedIn(const fs::path& listFile)
+/// A folder's instance list as a previous `bake scene` left it, read leniently: nothing from a
+/// list that is missing, unreadable or not one (a render of the folder refuses it itself).
+std::optional<nlohmann::json> previousList(const fs::path& listFile)
+{
+    std::ifstream in(listFile);
+    if (!in) return std::nullopt;
+    nlohmann::json list = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (!list.is_object()) return std::nullopt;
+    const auto format = list.find("format");
+    if (format == list.end() || *format != "pine-instances") return std::nullopt;
+    return list;
+}
+
+/// The files an instance list names: each placement's grids, their manifest and its mesh.
+/// Names that are not bare file names (a hand-edited "../x.vdb") are skipped, since only the
+/// folder's own files are meant.
+std::set<std::string> filesListed(const nlohmann::json& list)
 {
     std::set<std::string> names;
-    std::ifstream in(listFile);
-    const nlohmann::json list = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    if (!list.is_object() || list.value("format", "") != "pine-instances") return names;
     const auto instances = list.find("instances");
     if (instances == list.end() || !instances->is_array()) return names;
-    const auto add = [&](const nlohmann::json& name, const char* suffix) {
-        if (!name.is_string()) return;
-        const std::string bare = name.get<std::string>();
+    const auto add = [&](const nlohmann::json& entry, const char* key, const char* suffix) {
+        const auto name = entry.find(key);
+        if (name == entry.end() || !name->is_string()) return;
+        const std::string bare = name->get<std::string>();
         if (bare.empty() || bare == "." || bare == ".." || fs::path(bare).filename() != bare) {
             return;
         }
@@ -161,30 +173,47 @@ std::set<std::string> filesListedIn(const fs::path& listFile)
     };
     for (const nlohmann::json& entry : *instances) {
         if (!entry.is_object()) continue;
-        add(entry.value("grids", nlohmann::json()), "");
-        add(entry.value("grids", nlohmann::json()), ".json");  // the grids' manifest
-        add(entry.value("mesh", nlohmann::json()), "");
+        add(entry, "grids", "");
+        add(entry, "grids", ".json");  // the grids' manifest
+        add(entry, "mesh", "");
     }
     return names;
 }
 
-/// Removes from `dir` the files its previous instance list named (`before`) that the new one
-/// does not (`now`): a scene of fewer trees baked over a larger one would otherwise leave
-/// tree_NNN files that nothing lists and `bake verify DIR` reads as sound. Never an input.
-std::size_t removeUnlisted(const fs::path& dir, const std::set<std::string>& before,
-                           const std::set<std::string>& now, const fs::path& sceneFile)
+/// Writes the new instance list `list` to `listFile` and removes from its folder the files
+/// the list it replaces named and this one does not: a scene of fewer trees baked over a
+/// larger one would otherwise leave tree_NNN files that nothing lists. Both in the folder's
+/// turn (io::FolderLock), so that the list replaced is the one read. Never the list itself,
+/// an input or anything but a regular file; a file that cannot be removed is warned of, the
+/// bake being done. Returns how many were removed.
+std::size_t writeListInTurn(const fs::path& listFile, const nlohmann::json& list,
+                            const fs::path& sceneFile)
 {
     std::size_t removed = 0;
-    for (const std::string& name : before) {
-        if (now.count(name) != 0 || io::sameFile(dir / name, sceneFile)) continue;
-        std::error_code error;
-        if (fs::remove(dir / name, error)) {
-            ++removed;
-        } else if (error) {
-            throw InputError("cannot remove '" + (dir / name).string() +
-                             "', left from the folder's previous bake: " + error.message());
+    tbb::this_task_arena::isolate([&] {
+        const io::FolderLock turn(io::FolderLock::of(listFile));
+        const std::optional<nlohmann::json> before = previousList(listFile);
+        io::removeStaleTemporaries(listFile);
+        io::writeTextAtomically(listFile, list.dump(1) + "\n");
+        if (!before) return;
+        const std::set<std::string> now = filesListed(list);
+        const fs::path dir = io::folderOf(listFile);
+        for (const std::string& name : filesListed(*before)) {
+            const fs::path file = dir / name;
+            std::error_code error;
+            if (now.count(name) != 0 || name == listFile.filename() ||
+                !fs::is_regular_file(fs::symlink_status(file, error)) ||
+                io::sameFile(file, sceneFile)) {
+                continue;
+            }
+            if (fs::remove(file, error)) {
+                ++removed;
+            } else if (error) {
+                std::cerr << "bake: warning: cannot remove '" << file.string()
+                          << "', left from the folder's previous bake: " << error.message() << "\n";
+            }
         }
-    }
+    });
     return removed;
 }
 
@@ -210,7 +239,6 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
     // The folder made only once nothing above refuses the run.
     io::checkWritableFolder(dir);
     io::checkWritable(treeFile(dir, 0));
-    const std::set<std::string> listedBefore = filesListedIn(listFile);
     Totals totals;
     std::vector<bake::ProxyInstance> instances(n);
     tool::Progress progress("bake:");
@@ -220,16 +248,14 @@ int bakeScene(const fs::path& sceneFile, const bake::BakeSettings& common, const
         progress.count(totals.trees.load(), n, "trees");
     });
     progress.finish();
-    // Last: a list names only files already in place.
-    const nlohmann::json list = bake::instanceList(sceneFile.string(), output.unit, instances);
-    writeInTurn(listFile, list.dump(1) + "\n");
-    // Then what the previous list named and this one does not: a bake killed before this
-    // point leaves them, but its list (the previous one) still names them.
-    const std::size_t removed =
-        removeUnlisted(dir, listedBefore, filesListedIn(listFile), sceneFile);
+    // Last: a list names only files already in place. A bake killed before it leaves the
+    // previous list, which still names what this one would have removed.
+    const std::size_t removed = writeListInTurn(
+        listFile, bake::instanceList(sceneFile.string(), output.unit, instances), sceneFile);
     if (removed > 0) {
-        tool::info() << "bake: removed " << removed << " files of the previous bake in '"
-                     << dir.string() << "' that this scene does not have\n";
+        tool::info() << "bake: removed " << removed << (removed == 1 ? " file" : " files")
+                     << " of the previous bake in '" << dir.string()
+                     << "' that this scene does not have\n";
     }
     summarize(totals, start);
     return 0;
@@ -260,9 +286,10 @@ std::vector<FileToVerify> vdbFiles(const std::vector<fs::path>& paths)
         if (error) throw InputError("cannot list '" + path.string() + "': " + error.message());
         std::sort(inside.begin(), inside.end());
         const fs::path listFile = path / "instances.json";
-        const std::set<std::string> listed = filesListedIn(listFile);
+        const std::optional<nlohmann::json> list = previousList(listFile);
+        const std::set<std::string> listed = list ? filesListed(*list) : std::set<std::string>();
         for (const fs::path& file : inside) {
-            const bool unlisted = !listed.empty() && listed.count(file.filename().string()) == 0;
+            const bool unlisted = list && listed.count(file.filename().string()) == 0;
             files.push_back({file, unlisted
                                        ? "not in " + listFile.string() + ", left by another bake?"
                                        : std::string()});
@@ -273,7 +300,8 @@ std::vector<FileToVerify> vdbFiles(const std::vector<fs::path>& paths)
 
 /// Reads every file as a render would (manifest, then OpenVDB in a child process): one line
 /// each; status 2 if any is refused, else 3 if any was read without a manifest or lies in a
-/// baked folder whose instances.json does not name it (unverified).
+/// folder given whose instances.json does not name it (unverified; a file given by name is
+/// not checked against its folder's list).
 int verify(const std::vector<fs::path>& paths, double maxMemoryGiB)
 {
     const std::vector<FileToVerify> files = vdbFiles(paths);
@@ -365,8 +393,8 @@ int main(int argc, char** argv)
     auto* verifyCmd = app.add_subcommand(
         "verify",
         "Check baked files as a render reads them (manifest, then OpenVDB isolated); "
-        "exit status 2 if any is refused, 3 if any has no manifest or is not in its "
-        "folder's instances.json");
+        "exit status 2 if any is refused, 3 if any has no manifest or lies in a folder given "
+        "whose instances.json does not name it");
     verifyCmd->add_option("paths", verifyPaths, ".vdb files, or folders of them")->required();
     verifyCmd->add_option("--max-memory", maxMemoryGiB,
                           "Memory OpenVDB may use to read one file, in GiB (default: 80% of "

@@ -48,8 +48,8 @@ TEST(ResourceEstimate, VoxelsAreCountedInTheLeavesThatHoldThem)
     // OpenVDB allocates a leaf's 8^3 voxels whole, and a thin bough fills few of them: the
     // estimate's voxel memory is the leaves the boughs reach, so it must follow a real bake's
     // leaves at every voxel size (a fir's leaves hold about 100 voxels at 0.5 cm, 33 at 2 cm).
-    // Counting voxels as if they filled their leaves put the paper forest's reference at 0.43
-    // GiB against a peak of 0.90 at 1 cm.
+    // Counting voxels as if they filled their leaves put the paper forest's reference at 426
+    // MiB against a peak of 876 MiB at 1 cm.
     const scenes::Scene scene =
         scenes::loadScene(std::string(PINE_SOURCE_DIR) + "/scenes/paper-forest.json");
     const scenes::Tree tree =
@@ -63,8 +63,8 @@ TEST(ResourceEstimate, VoxelsAreCountedInTheLeavesThatHoldThem)
         for (const ResourceEstimate::Part& p : e.parts) {
             if (p.what.find("voxels of") != std::string::npos) voxelBytes = p.bytes;
         }
-        // The bake's bytes a leaf: 512 voxels of the grids, the keys and sums, and the copy
-        // written.
+        // The bake's bytes a leaf: 512 voxels of the grids, the keys and sums (60 bytes), and
+        // the copy written (60), as resource_estimate.cpp counts them.
         const double estimated = voxelBytes / (512.0 * 120.0);
         EXPECT_NEAR(estimated / leaves, 1.0, 0.15) << h << " cm: " << leaves << " leaves";
     }

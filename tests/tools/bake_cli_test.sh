@@ -118,6 +118,22 @@ cp "$work/kept/"* "$work/forest/"
 grep -q "tree_000.vdb: ok, " "$work/out" || fail "verify: $(cat "$work/out")"
 grep -q "tree_002.vdb: unverified, .*(not in $work/forest/instances.json, left by another bake?)$" "$work/out" \
     || fail "verify of an unlisted tree file: $(cat "$work/out")"
+# The previous list's names are trusted only as bare names of regular files: never the list
+# itself, the scene, a folder or a file outside; a list that is not one removes nothing.
+mkdir -p "$work/safe/sub"
+cp "$bough" "$work/safe/scene.json"
+echo keep >"$work/outside.vdb"
+echo '{"format": "pine-instances", "instances": [{"grids": "../outside.vdb", "mesh": "instances.json"},
+      {"grids": "scene.json", "mesh": "sub"}]}' >"$work/safe/instances.json"
+"$bake" scene "$work/safe/scene.json" --voxel-size 2 --levels 1 --out-dir "$work/safe" 2>"$work/err" \
+    || fail "bake over a hostile list failed: $(tail -1 "$work/err")"
+[ -f "$work/outside.vdb" ] && [ -f "$work/safe/scene.json" ] && [ -d "$work/safe/sub" ] && [ -s "$work/safe/instances.json" ] \
+    || fail "a hostile list removed what it must not: $(ls -A "$work" "$work/safe")"
+grep -q "removed" "$work/err" && fail "a hostile list removed something: $(cat "$work/err")"
+echo '{"format": 5, "instances": [{"grids": "tree_000.obj"}]}' >"$work/safe/instances.json"
+"$bake" scene "$work/safe/scene.json" --voxel-size 2 --levels 1 --out-dir "$work/safe" 2>"$work/err" \
+    || fail "bake over a list of another format failed: $(tail -1 "$work/err")"
+[ -f "$work/safe/tree_000.obj" ] || fail "a list of another format removed a file"
 if command -v vdb_print >/dev/null; then
     vdb_print "$work/forest/tree_000.vdb" | grep -q "density_level_1" || fail "vdb_print lacks density_level_1"
 fi
