@@ -108,7 +108,7 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--rolls", o.rolls, "Needle rolls the explicit needles are averaged over")
         ->capture_default_str()
-        ->check(CLI::Range(1, 64));
+        ->check(pine::tool::wholeNumberIn(1, 64));
     std::string origin = "needles";
     app.add_option("--shadow-origin", origin, "The multiscale levels' render.shadow_origin")
         ->capture_default_str()

@@ -54,7 +54,7 @@ int main(int argc, char** argv)
     long points = 400000;
     app.add_option("--points", points, "Random points on the needles")
         ->capture_default_str()
-        ->check(CLI::Range(1000L, 100000000L));
+        ->check(pine::tool::wholeNumberIn(1000, 100000000));
     return pine::tool::run("self_shadowing_study", app, argc, argv, [&] {
         const Vec3 L = pine::study::lightDirection(light), V(0.0, -1.0, 0.0);
         const LayerModel& layers = layerModel("fibre", layerCorrelated(correlation));

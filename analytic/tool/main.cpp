@@ -22,7 +22,7 @@ int main(int argc, char** argv)
     sweepCmd->add_option("--out", sweep.outDir, "Output folder (created if missing)")->required();
     sweepCmd->add_option("--cone-cases", sweep.coneCases, "Random cases for the cone fits")
         ->capture_default_str()
-        ->check(CLI::Range(10, 1000000));
+        ->check(pine::tool::wholeNumberIn(10, 1000000));
     sweepCmd->add_option("--seed", sweep.seed, "Seed of the random cases")->capture_default_str();
     sweepCmd->add_flag("!--no-plot", sweep.plot, "Skip the plot (CSV and JSON only)");
 

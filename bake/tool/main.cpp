@@ -366,7 +366,7 @@ int main(int argc, char** argv)
         cmd->add_option("--levels", settings.pyramidLevels,
                         "Density levels at h, 2h, 4h, ... (1: no pyramid)")
             ->default_val(settings.pyramidLevels)
-            ->check(CLI::Range(1, 16));
+            ->check(tool::wholeNumberIn(1, 16));
         cmd->add_option("--units", units,
                         "Length unit of the files (transform, extinction per unit length, mesh)")
             ->default_val(units)

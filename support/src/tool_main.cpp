@@ -163,24 +163,34 @@ CLI::Validator positiveNumber()
         "> 0");
 }
 
-CLI::Validator wholeNumberAtLeast(long least)
+CLI::Validator wholeNumberIn(long least, long most)
 {
+    const std::string wanted =
+        most == std::numeric_limits<long>::max()
+            ? ">= " + std::to_string(least)
+            : "from " + std::to_string(least) + " to " + std::to_string(most);
     return CLI::Validator(
-        [least](std::string& text) -> std::string {
-            const std::string refused =
-                "must be a whole number >= " + std::to_string(least) + ", got '" + text + "'";
+        [=](std::string& text) -> std::string {
+            const std::string refused = "must be a whole number " + wanted + ", got '" + text + "'";
             // stol skips leading spaces and stops at trailing ones: refused both ways, as
             // whyNotANumber refuses them.
             if (spacedAbout(text)) return refused + ", with spaces about it";
             try {
                 std::size_t used = 0;
                 const long v = std::stol(text, &used, 0);  // as CLI11 reads it: 010 is 8
-                if (used == text.size() && v >= least) return {};
+                if (used == text.size() && v >= least && v <= most) return {};
             } catch (const std::exception&) {
             }
             return refused;
         },
-        ">= " + std::to_string(least));
+        most == std::numeric_limits<long>::max()
+            ? ">= " + std::to_string(least)
+            : "in [" + std::to_string(least) + ", " + std::to_string(most) + "]");
+}
+
+CLI::Validator wholeNumberAtLeast(long least)
+{
+    return wholeNumberIn(least, std::numeric_limits<long>::max());
 }
 
 CLI::Validator numberIn(double least, double most)

@@ -308,6 +308,8 @@ expect_error "a number with a tail" 2 "--cone-level-max: must be a number > 0, g
 # Spaces about a number are refused either side (a leading one was taken, a trailing one not).
 expect_error "a number after a space" 2 "--cone-level-max: must be a number > 0, got ' 3', with spaces about it" -- \
     render "$src/scenes/bough.json" --cone-level-max " 3" --out "$work/n2.exr"
+expect_error "a bounded whole number after a space" 2 "--samples: must be a whole number from 1 to 65536, got ' 4', with spaces about it" -- \
+    render "$src/scenes/bough.json" --method geometry --samples " 4" --out "$work/n2.exr"
 expect_error "a whole number before a space" 2 "--threads: must be a whole number >= 0, got '2 ', with spaces about it" -- \
     render "$src/scenes/bough.json" --threads "2 " --out "$work/n2.exr"
 expect_error "a band too wide for the thresholds" 2 "--level-blend 2 must be at most sqrt(cone_level_max / needle_level_max) (1.09545) for cone_level_max 0.3" -- \

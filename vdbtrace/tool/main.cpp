@@ -1391,14 +1391,15 @@ int main(int argc, char** argv)
     renderCmd->add_option("--grids", gridFiles,
                           "reference: baked .vdb files (bake tree/scene) instead of baking now")
         ->check(CLI::ExistingFile);
-    renderCmd->add_option("--subpixels", settings.reference.subpixels,
-                          "reference: rays per pixel along each axis (the cone's footprint)")
+    renderCmd
+        ->add_option("--subpixels", settings.reference.subpixels,
+                     "reference: rays per pixel along each axis (the cone's footprint)")
         ->capture_default_str()
-        ->check(CLI::Range(1, 16));
-    renderCmd->add_option("--samples", settings.geometry.samples,
-                          "geometry: point samples per pixel")
+        ->check(tool::wholeNumberIn(1, 16));
+    renderCmd
+        ->add_option("--samples", settings.geometry.samples, "geometry: point samples per pixel")
         ->capture_default_str()
-        ->check(CLI::Range(1, 65536));
+        ->check(tool::wholeNumberIn(1, 65536));
     renderCmd->add_option("--sample-seed", settings.geometry.sampleSeed,
                           "geometry: another shift of the sample sequence, for an independent "
                           "render with the same error statistics")
@@ -1430,9 +1431,10 @@ int main(int argc, char** argv)
         ->check(CLI::IsMember({"level"}));
     ModelOverrides model;
     model.add(*renderCmd);
-    renderCmd->add_option("--force-level", settings.multiscale.forceLevel,
-                          "multiscale: shade every bough hit at level 1, 2 or 3")
-        ->check(CLI::Range(0, 3));
+    renderCmd
+        ->add_option("--force-level", settings.multiscale.forceLevel,
+                     "multiscale: shade every bough hit at level 1, 2 or 3")
+        ->check(tool::wholeNumberIn(0, 3));
     double lawCacheMiB = 0.0;  // 0: keep every profile
     renderCmd
         ->add_option("--law-cache", lawCacheMiB,
@@ -1454,7 +1456,7 @@ int main(int argc, char** argv)
     benchCmd
         ->add_option("--geometry-samples", benchGeometrySamples,
                      "Samples per pixel of the geometry render timed beside it (0: none)")
-        ->check(CLI::Range(0, 4096))
+        ->check(tool::wholeNumberIn(0, 4096))
         ->capture_default_str();
     vdbtrace::NeedlePrimitive benchPrimitive = vdbtrace::NeedlePrimitive::Curve;
     addNeedlePrimitive(*benchCmd, benchPrimitive);
@@ -1493,7 +1495,7 @@ int main(int argc, char** argv)
             ->check(CLI::IsMember(vdbtrace::growthAxisNames()));
     // Without --grow these would be ignored without a word.
     benchCmd->add_option("--grow-steps", growSteps, "Steps of --grow, the first the scene as is")
-        ->check(CLI::Range(2, 8))
+        ->check(tool::wholeNumberIn(2, 8))
         ->capture_default_str()
         ->needs(grow);
     benchCmd
@@ -1543,7 +1545,7 @@ int main(int argc, char** argv)
         ->add_option("--truth-samples", truthSamples,
                      "Samples per pixel of the ground truth (default 64, 16 with --quick); it "
                      "is checked against 4 times as many")
-        ->check(CLI::Range(1, 4096));
+        ->check(tool::wholeNumberIn(1, 4096));
     compareCmd
         ->add_option("--repeat", compareRepeat,
                      "Runs of each render, round by round (each setting once a round), timed "
@@ -1575,7 +1577,7 @@ int main(int argc, char** argv)
                   "WxH instead of the camera's (same view, vertical field kept)", "320x240");
     animateCmd->add_option("--strip", animate.stripFrames, "Frames shown in strip.png")
         ->capture_default_str()
-        ->check(CLI::Range(1, 16));
+        ->check(tool::wholeNumberIn(1, 16));
     animateCmd->add_flag("--self-shadowing", animate.addSelfShadowing,
                          "Add self_shadowing where the scene's effects name shadows (the "
                          "explicit needles always self-shadow; a scene with shadows alone is "
@@ -1587,7 +1589,7 @@ int main(int argc, char** argv)
                      "each method's error flicker against it: the camera's motion cancels (0: "
                      "none)")
         ->capture_default_str()
-        ->check(CLI::Range(0, 65536));
+        ->check(tool::wholeNumberIn(0, 65536));
     addMaxMemory(*animateCmd, maxMemoryGiB, "a temporal comparison");
     model.add(*animateCmd);
 

@@ -35,6 +35,9 @@ void errorLine(const std::string& text);
 CLI::Validator positiveNumber();
 /// A whole number >= least, named in its message (CLI::NonNegativeNumber's prints DBL_MAX).
 CLI::Validator wholeNumberAtLeast(long least);
+/// A whole number from `least` to `most`, without spaces about it (CLI::Range, through
+/// strtoll, took ' 3' and refused '3 ').
+CLI::Validator wholeNumberIn(long least, long most);
 /// A finite number from `least` to `most` (+infinity: no bound above): CLI::Range lets nan
 /// through, which the options then read as their default.
 CLI::Validator numberIn(double least, double most);
