@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace pine::bake {
@@ -173,6 +174,17 @@ TEST(BakeBoughs, EveryVoxelSamplesTheFieldAtItsCentre)
     EXPECT_GT(inside, 1000);
 }
 
+/// Two 16 cm paper boughs crossing at right angles, the second denser (24 needles per cone,
+/// albedo 0.5).
+std::pair<BoughSpec, BoughSpec> crossingBoughs()
+{
+    const BoughSpec thin = test::paperBough(Vec3(-8.0, 0.0, 0.0), Vec3(1, 0, 0), 16.0);
+    BoughSpec dense = test::paperBough(Vec3(0.0, -8.0, 0.3), Vec3(0, 1, 0), 16.0);
+    dense.needles.cone.needlesPerCone = 24;
+    dense.needleAlbedo = Vec3(0.5);
+    return {thin, dense};
+}
+
 TEST(BakeBoughs, OverlappingBoughsAddTheirExtinctionWhateverTheOrder)
 {
     // Two boughs crossing at right angles, the second denser (more needles per cone): where
@@ -181,10 +193,7 @@ TEST(BakeBoughs, OverlappingBoughsAddTheirExtinctionWhateverTheOrder)
     // the gradient scaled to that sum), whichever is listed first. Under the layer law a
     // bough's extinction is uniform, so the denser is the same everywhere. The voxelized mass
     // of the two is the sum of each one's alone.
-    const BoughSpec thin = test::paperBough(Vec3(-8.0, 0.0, 0.0), Vec3(1, 0, 0), 16.0);
-    BoughSpec dense = test::paperBough(Vec3(0.0, -8.0, 0.3), Vec3(0, 1, 0), 16.0);
-    dense.needles.cone.needlesPerCone = 24;
-    dense.needleAlbedo = Vec3(0.5);
+    const auto [thin, dense] = crossingBoughs();
     const BakeSettings settings{0.3, 1, "layer"};
     const TreeGrids ab = bakeBoughs({thin, dense}, settings);
     const TreeGrids ba = bakeBoughs({dense, thin}, settings);
@@ -224,10 +233,7 @@ TEST(BakeBoughs, TreesMergedOverlapAsTheirBoughsBakedTogetherDo)
 {
     // Two crossing boughs, each baked as a tree of its own and merged (a render's --grids), or
     // baked together (a render's own bake): the same voxels, densities and fields.
-    const BoughSpec thin = test::paperBough(Vec3(-8.0, 0.0, 0.0), Vec3(1, 0, 0), 16.0);
-    BoughSpec dense = test::paperBough(Vec3(0.0, -8.0, 0.3), Vec3(0, 1, 0), 16.0);
-    dense.needles.cone.needlesPerCone = 24;
-    dense.needleAlbedo = Vec3(0.5);
+    const auto [thin, dense] = crossingBoughs();
     const BakeSettings settings{0.3, 1, "layer"};
     const TreeGrids together = bakeBoughs({thin, dense}, settings);
     const TreeGrids merged =
