@@ -76,22 +76,30 @@ Camera CameraPath::at(double frame, const Camera& still) const
     return c;
 }
 
-std::string cameraProblem(const Camera& c)
+CameraFault cameraFault(const Camera& c)
 {
     const Vec3 view = c.lookAt_cm - c.position_cm;
-    if (!(glm::length(view) > 0.0)) return "look_at equals position (no view direction)";
+    if (!(glm::length(view) > 0.0)) return {"look_at", "equals position (no view direction)"};
+    // Each coordinate finite, their distance not: the view direction would be zero.
     if (!std::isfinite(glm::length(view))) {
-        return "look_at lies too far from position for its distance to be a number";
+        return {"look_at", "lies too far from position for its distance to be a number"};
     }
+    // An up vector along the view leaves the image's roll undefined.
     if (!(glm::length(glm::cross(glm::normalize(view), c.up)) >= 1e-6)) {
-        return "up is parallel to the view direction (or zero)";
+        return {"up", "is parallel to the view direction (or zero)"};
     }
     if (!(c.fovY_rad > 0.0 && c.fovY_rad < std::numbers::pi)) {
         std::ostringstream fov;
-        fov << "fov_deg " << c.fovY_rad * 180.0 / std::numbers::pi << " is outside (0, 180)";
-        return fov.str();
+        fov << c.fovY_rad * 180.0 / std::numbers::pi << " is outside (0, 180)";
+        return {"fov_deg", fov.str()};
     }
     return {};
+}
+
+std::string cameraProblem(const Camera& c)
+{
+    const CameraFault fault = cameraFault(c);
+    return fault ? fault.key + " " + fault.why : std::string();
 }
 
 const char* interpolationName(CameraPath::Interpolation interpolation)

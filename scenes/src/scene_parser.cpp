@@ -30,20 +30,9 @@ Camera readCamera(const Json& value, const Where& where)
     Camera c;
     c.position_cm = r.vec3("position");
     c.lookAt_cm = r.vec3("look_at");
-    const Vec3 view = c.lookAt_cm - c.position_cm;
-    if (!(glm::length(view) > 0.0)) {
-        where.key("look_at").fail("equals position (no view direction)");
-    }
-    // Each coordinate finite, their distance not: the view direction would be zero.
-    if (!std::isfinite(glm::length(view))) {
-        where.key("look_at").fail("lies too far from position for its distance to be a number");
-    }
     if (const Json* up = r.optional("up")) c.up = detail::readDirection(*up, where.key("up"));
-    // An up vector along the view leaves the image's roll undefined.
-    if (glm::length(glm::cross(glm::normalize(view), c.up)) < 1e-6) {
-        where.key("up").fail("must not be parallel to the view direction");
-    }
     c.fovY_rad = kRadPerDeg * r.number("fov_deg", Range::open(0, 180), c.fovY_rad / kRadPerDeg);
+    if (const CameraFault fault = cameraFault(c)) where.key(fault.key).fail(fault.why);
     if (const Json* resolution = r.optional("resolution")) {
         const Where at = where.key("resolution");
         if (!resolution->is_array() || resolution->size() != 2) {

@@ -50,8 +50,19 @@ struct CameraPath {
     Camera at(double frame, const Camera& still) const;
 };
 
-/// Why `camera` cannot render (its look-at on its position, its up along the view or zero, its
-/// field of view outside (0, 180) degrees), or empty if it can.
+/// What keeps a camera from rendering: the scene key at fault ("look_at", "up", "fov_deg")
+/// and why, or an empty key if nothing does.
+struct CameraFault {
+    std::string key, why;
+    explicit operator bool() const { return !key.empty(); }
+};
+
+/// What keeps `camera` from rendering: its look-at on its position or too far from it for the
+/// distance to be a number, its up along the view or zero, its field of view outside (0, 180)
+/// degrees. The scene reader names the key; camera paths and --frames word it whole.
+CameraFault cameraFault(const Camera& camera);
+
+/// cameraFault as one phrase ("look_at equals position (no view direction)"), or empty.
 std::string cameraProblem(const Camera& camera);
 
 /// The interpolation's names as a scene file writes them ("smooth", "linear").
