@@ -253,6 +253,9 @@ void checkWritableFolder(const fs::path& folder)
         throw InputError("cannot write into '" + folder.string() + "': " +
                          (error ? "cannot create it: " + error.message() : why));
     }
+    // The probes of runs killed between making one and removing it (a probe of a run now,
+    // removed under it, only fails to remove it itself).
+    removeStaleTemporaries(folder / "probe");
 }
 
 }  // namespace pine::io
