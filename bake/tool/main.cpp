@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -44,15 +45,27 @@ struct Output {
     bool treeFrame = true;
 };
 
-/// Writes `text` to `file` atomically in the folder's turn (io::FolderLock, as the grids are):
-/// the temporaries a killed bake left are removed, a live one's never are.
-void writeInTurn(const fs::path& file, const std::string& text)
+/// Runs `work` in the turn of `file`'s folder (io::FolderLock, as the grids are written),
+/// isolated so that the thread waits for the lock without taking other tasks.
+void inFolderTurn(const fs::path& file, const std::function<void()>& work)
 {
     tbb::this_task_arena::isolate([&] {
         const io::FolderLock turn(io::FolderLock::of(file));
-        io::removeStaleTemporaries(file);
-        io::writeTextAtomically(file, text);
+        work();
     });
+}
+
+/// Writes `text` to `file` atomically, in its folder's turn: the temporaries a killed bake
+/// left are removed, a live one's never are.
+void writeTextReplacingStale(const fs::path& file, const std::string& text)
+{
+    io::removeStaleTemporaries(file);
+    io::writeTextAtomically(file, text);
+}
+
+void writeInTurn(const fs::path& file, const std::string& text)
+{
+    inFolderTurn(file, [&] { writeTextReplacingStale(file, text); });
 }
 
 /// The mesh of the trunk and branches beside a tree's grids.
@@ -190,11 +203,9 @@ std::size_t writeListInTurn(const fs::path& listFile, const nlohmann::json& list
                             const fs::path& sceneFile)
 {
     std::size_t removed = 0;
-    tbb::this_task_arena::isolate([&] {
-        const io::FolderLock turn(io::FolderLock::of(listFile));
+    inFolderTurn(listFile, [&] {
         const std::optional<nlohmann::json> before = previousList(listFile);
-        io::removeStaleTemporaries(listFile);
-        io::writeTextAtomically(listFile, list.dump(1) + "\n");
+        writeTextReplacingStale(listFile, list.dump(1) + "\n");
         if (!before) return;
         const std::set<std::string> now = filesListed(list);
         const fs::path dir = io::folderOf(listFile);
