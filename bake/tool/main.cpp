@@ -55,7 +55,7 @@ void inFolderTurn(const fs::path& file, const std::function<void()>& work)
     });
 }
 
-/// Writes `text` to `file` atomically, in its folder's turn: the temporaries a killed bake
+/// Writes `text` to `file` atomically (call it in the folder's turn): the temporaries a killed bake
 /// left are removed, a live one's never are.
 void writeTextReplacingStale(const fs::path& file, const std::string& text)
 {
