@@ -63,6 +63,12 @@ PreparedBough::PreparedBough(const BoughSpec& spec)
     mCotPhi = mCosPhi / mSinPhi;
     mInvSpacing = 1.0 / spec.needles.coneSpacing_cm;
     if (mLength > 0.0) mAxis = (spec.tip_cm - spec.base_cm) / mLength;
+    // The world axis least along the branch, made orthogonal to it.
+    Vec3 least(0.0);
+    least[std::abs(mAxis.x) <= std::abs(mAxis.y)
+              ? (std::abs(mAxis.x) <= std::abs(mAxis.z) ? 0 : 2)
+              : (std::abs(mAxis.y) <= std::abs(mAxis.z) ? 1 : 2)] = 1.0;
+    mAnyRadial = glm::normalize(least - glm::dot(least, mAxis) * mAxis);
     mEmpty = !(mLength > 0.0 && mRadius > 0.0 && mOpacity > 0.0 && std::isfinite(mAxis.x));
 }
 
@@ -73,14 +79,30 @@ std::optional<LayerSample> PreparedBough::sample(const Vec3& x_cm) const
     const double h = glm::dot(v, mAxis);
     const Vec3 across = v - h * mAxis;
     const double rho = glm::length(across);
-    // On the axis every cone has its apex and the radial direction is undefined.
-    if (!(rho >= 1e-9) || rho > mRadius) return std::nullopt;
+    if (!(rho <= mRadius)) return std::nullopt;
     // g = h - rho cot(phi) is the height of the apex of the cone through x: the cones' apexes
     // lie on the branch, between its base and its tip.
     const double g = h - rho * mCotPhi;
     if (g < 0.0 || g > mLength) return std::nullopt;
+    return fieldAcross(across, rho);
+}
 
-    const Vec3 radial = across / rho;
+std::optional<LayerSample> PreparedBough::sampleAcross(const Vec3& x_cm) const
+{
+    if (mEmpty) return std::nullopt;
+    const Vec3 v = x_cm - mBase;
+    const Vec3 across = v - glm::dot(v, mAxis) * mAxis;
+    const double rho = glm::length(across);
+    if (!std::isfinite(rho)) return std::nullopt;
+    return fieldAcross(rho <= mRadius ? across : across * (mRadius / rho), std::min(rho, mRadius));
+}
+
+LayerSample PreparedBough::fieldAcross(const Vec3& across, double rho) const
+{
+    // On the axis every cone has its apex and the radial direction is undefined; any will do,
+    // since the needles' density there (|G| = 1 / (dh sin(phi)), coverage 1) is not. Dropping
+    // the axis lost a whole row of voxels where it runs through their centres.
+    const Vec3 radial = rho >= 1e-9 ? across / rho : mAnyRadial;
     LayerSample s;
     s.gradient = (mAxis - mCotPhi * radial) * mInvSpacing;  // grad g / dh
     s.needle = mCosPhi * mAxis + mSinPhi * radial;

@@ -21,6 +21,10 @@ public:
 
     /// The field at x, or nothing outside the region (layer_field.h).
     std::optional<LayerSample> sample(const Vec3& x_cm) const;
+    /// The field at x's distance from the axis, at most R, in x's direction across it: what
+    /// the region holds beside x, wherever x lies along the axis (the field depends on the
+    /// distance and direction alone), or nothing for an empty bough.
+    std::optional<LayerSample> sampleAcross(const Vec3& x_cm) const;
 
     /// The cylinder that holds the region: from base along the axis for extent_cm() =
     /// length + R cot(phi) (the last cone's rim), radius R.
@@ -30,7 +34,10 @@ public:
     double radius_cm() const { return mRadius; }
 
 private:
+    LayerSample fieldAcross(const Vec3& across, double rho) const;
+
     Vec3 mBase{0.0}, mAxis{0.0, 0.0, 1.0};
+    Vec3 mAnyRadial{1.0, 0.0, 0.0};  ///< a unit vector across the axis, for points on it
     double mLength = 0.0, mRadius = 0.0, mCotPhi = 0.0, mCosPhi = 1.0, mSinPhi = 0.0;
     double mInvSpacing = 0.0, mOpacity = 0.0;
     double mCoverageTimesRho = 0.0;  ///< N r / pi

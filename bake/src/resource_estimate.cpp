@@ -122,7 +122,15 @@ double leavesOf(const SpeciesSample& tree, double h)
     // Points across and along a bough: each centred in one of n equal cells at most a step wide.
     const auto cells = [step](double width) { return std::max(1.0, std::ceil(width / step)); };
     double points = 0.0;
-    for (const BoughCylinder& b : tree.boughs) {
+    // The cylinder of the voxels a bough fills: about half a voxel wider where the bake
+    // averages voxels' boxes, which then fills every voxel one of its points inside falls in.
+    const auto filledBy = [h](const BoughCylinder& b) {
+        if (boxPointsPerEdge(b.radius_cm, h) == 1) return b;
+        return BoughCylinder{b.base - 0.5 * h * b.axis, b.axis, b.extent_cm + h,
+                             b.radius_cm + 0.5 * h};
+    };
+    for (const BoughCylinder& bough : tree.boughs) {
+        const BoughCylinder b = filledBy(bough);
         points += cells(b.extent_cm) * cells(2.0 * b.radius_cm) * cells(2.0 * b.radius_cm);
     }
     if (!(points <= kMostPoints)) return 1.25 * filled;
@@ -137,7 +145,8 @@ double leavesOf(const SpeciesSample& tree, double h)
     std::unordered_set<std::array<long long, 3>, Hash> leaves;
     // A leaf index a long long cannot hold (tiny leaves far out) falls back to the volume.
     constexpr double kMostIndex = 1e18;
-    for (const BoughCylinder& b : tree.boughs) {
+    for (const BoughCylinder& bough : tree.boughs) {
+        const BoughCylinder b = filledBy(bough);
         const Vec3 helper = std::abs(b.axis.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
         const Vec3 u = glm::normalize(glm::cross(b.axis, helper)), v = glm::cross(b.axis, u);
         const int along = int(cells(b.extent_cm)), across = int(cells(2.0 * b.radius_cm));

@@ -87,6 +87,51 @@ TEST(BakeBoughs, MassOfALongBoughMatchesTheIntegral)
     }
 }
 
+TEST(BakeBoughs, CoarseVoxelsKeepTheBoughsExtinction)
+{
+    // A voxel wider than a quarter of R holds the field's mean over its box, so that the mass
+    // stays the integral's (as in MassOfALongBoughMatchesTheIntegral) however coarse the
+    // voxels. Two boughs: one whose axis runs along a lattice axis through voxel centres, where
+    // centres alone lose whole rows (a 2R bake of it was empty, every centre on the axis or
+    // beyond R), and an oblique one. And every voxel's layered fields meet its density, under
+    // each law, as the reference reads them.
+    const double L = 60.0;
+    for (const Vec3& axis : {Vec3(1, 0, 0), Vec3(0.3, 0.5, 0.8)}) {
+        const BoughSpec b = test::paperBough(Vec3(0.0), axis, L);
+        const analytic::ConeGeometry& c = b.needles.cone;
+        const double phi = c.aperture_rad, R = c.needleLength_cm * std::sin(phi);
+        const double mu = -std::log(1.0 - 2.0 * c.needlesPerCone * c.needleRadius_cm / (kPi * R));
+        const double exact =
+            mu / (2.0 * b.needles.coneSpacing_cm * std::sin(phi)) * kPi * R * R * L;
+        for (const double h : {R / 2, R, 2 * R, 4 * R}) {
+            for (const char* name : {"layer", "fibre"}) {
+                const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 1, name});
+                if (std::string(name) == "layer") {
+                    EXPECT_NEAR(voxelizedMass(g) / exact, 1.0, 0.015)
+                        << "axis " << axis.x << " h " << h;
+                }
+                const ExtinctionLaw& law = extinctionLaw(name);
+                auto gradient = g.layerGradient->getConstAccessor();
+                auto needle = g.needleDirection->getConstAccessor();
+                auto opacity = g.layerOpacity->getConstAccessor();
+                auto coverage = g.needleCoverage->getConstAccessor();
+                for (auto it = g.density->cbeginValueOn(); it; ++it) {
+                    const openvdb::Coord ijk = it.getCoord();
+                    LayerSample s;
+                    const auto vec = [](const openvdb::Vec3s& v) {
+                        return Vec3(v.x(), v.y(), v.z());
+                    };
+                    s.gradient = vec(gradient.getValue(ijk));
+                    s.needle = vec(needle.getValue(ijk));
+                    s.layerOpacity = opacity.getValue(ijk);
+                    s.needleCoverage = coverage.getValue(ijk);
+                    ASSERT_NEAR(law.meanExtinction(s), *it, 1e-5 * *it) << name << " " << ijk;
+                }
+            }
+        }
+    }
+}
+
 /// Index box around a bough's region (its cones' reach), widened by one voxel.
 openvdb::CoordBBox searchBox(const BoughSpec& b, double h)
 {
@@ -263,24 +308,27 @@ TEST(BakeBoughs, TheGridsDoNotDependOnTheThreads)
         const Vec3 axis(std::cos(a) * std::cos(b), std::sin(a) * std::cos(b), std::sin(b));
         star.push_back(test::paperBough(-6.0 * axis + Vec3(0.01 * i), axis, 12.0));
     }
-    const BakeSettings settings{0.2, 1, "fibre"};
-    const auto bakeWith = [&](int threads) {
-        tbb::task_arena arena(threads);
-        return arena.execute([&] { return bakeBoughs(star, settings); });
-    };
-    const TreeGrids one = bakeWith(1);
-    for (const int threads : {2, 3, 7}) {
-        const TreeGrids many = bakeWith(threads);
-        ASSERT_EQ(one.density->activeVoxelCount(), many.density->activeVoxelCount());
-        auto d = many.density->getConstAccessor();
-        auto g = many.layerGradient->getConstAccessor();
-        auto og = one.layerGradient->getConstAccessor();
-        int differ = 0;
-        for (auto it = one.density->cbeginValueOn(); it; ++it) {
-            differ += *it != d.getValue(it.getCoord()) ||
-                      og.getValue(it.getCoord()) != g.getValue(it.getCoord());
+    // Voxels read at their centres (0.2 cm) and averaged over their boxes (0.8 cm, 8 points).
+    for (const double h : {0.2, 0.8}) {
+        const BakeSettings settings{h, 1, "fibre"};
+        const auto bakeWith = [&](int threads) {
+            tbb::task_arena arena(threads);
+            return arena.execute([&] { return bakeBoughs(star, settings); });
+        };
+        const TreeGrids one = bakeWith(1);
+        for (const int threads : {2, 3, 7}) {
+            const TreeGrids many = bakeWith(threads);
+            ASSERT_EQ(one.density->activeVoxelCount(), many.density->activeVoxelCount());
+            auto d = many.density->getConstAccessor();
+            auto g = many.layerGradient->getConstAccessor();
+            auto og = one.layerGradient->getConstAccessor();
+            int differ = 0;
+            for (auto it = one.density->cbeginValueOn(); it; ++it) {
+                differ += *it != d.getValue(it.getCoord()) ||
+                          og.getValue(it.getCoord()) != g.getValue(it.getCoord());
+            }
+            EXPECT_EQ(differ, 0) << threads << " threads, " << h << " cm";
         }
-        EXPECT_EQ(differ, 0) << threads << " threads";
     }
 }
 

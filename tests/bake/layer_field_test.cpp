@@ -60,6 +60,33 @@ TEST(LayerField, MeanOverTheSphereIsHalfTheGradientNorm)
     }
 }
 
+TEST(LayerField, OnTheAxisTheNeedlesAreAsDenseAsBesideIt)
+{
+    // On the branch's axis every cone has its apex and no direction across it is singled out,
+    // but the needles are there: the field exists, as dense as just beside the axis (|G| =
+    // 1 / (dh sin(phi)), coverage 1), its needle phi from the axis. It was once left out, and
+    // a bake whose voxel centres lay on a branch's axis lost that whole row of voxels.
+    for (const Vec3& axis : {Vec3(1, 0, 0), Vec3(0, 0, -1), unit(0.3, -0.5, 0.8)}) {
+        const BoughSpec b = test::paperBough(Vec3(1.0, 2.0, -3.0), axis, 30.0);
+        const double phi = b.needles.cone.aperture_rad;
+        const Vec3 x = b.base_cm + 12.0 * axis;
+        const auto on = sampleBough(b, x);
+        const auto beside = sampleBough(b, x + 1e-6 * perpendicular(axis));
+        ASSERT_TRUE(on && beside) << axis.x << " " << axis.z;
+        EXPECT_NEAR(glm::length(on->gradient) * b.needles.coneSpacing_cm * std::sin(phi), 1.0,
+                    1e-12);
+        EXPECT_EQ(on->needleCoverage, 1.0);
+        EXPECT_NEAR(glm::dot(on->needle, axis), std::cos(phi), 1e-12);
+        EXPECT_NEAR(glm::length(on->needle), 1.0, 1e-12);
+        for (const char* name : {"layer", "fibre", "poisson"}) {
+            const ExtinctionLaw& law = extinctionLaw(name);
+            EXPECT_NEAR(law.meanExtinction(*on), law.meanExtinction(*beside),
+                        1e-9 * law.meanExtinction(*beside))
+                << name;
+        }
+    }
+}
+
 /// Cones crossed between t0 and t1 on x(t) = origin + t d, counted one by one: the changes of
 /// floor(g / dh) at steps of `step`, g = h - rho cot(phi) the apex height of the cone through
 /// x(t), counted only inside the region. Independent of LayerSample.
@@ -140,8 +167,8 @@ TEST(LayerField, NothingOutsideTheRegion)
     const Vec3 e(1.0, 0.0, 0.0);
     // Inside: halfway out, halfway along.
     EXPECT_TRUE(sampleBough(b, 5.0 * axis + 0.5 * R * e));
-    // On the axis: the radial direction is undefined.
-    EXPECT_FALSE(sampleBough(b, 5.0 * axis));
+    // On the axis, where every cone has its apex (OnTheAxisTheNeedlesAreAsDenseAsBesideIt).
+    EXPECT_TRUE(sampleBough(b, 5.0 * axis));
     // Beyond the needles' reach.
     EXPECT_FALSE(sampleBough(b, 5.0 * axis + 1.001 * R * e));
     EXPECT_TRUE(sampleBough(b, 5.0 * axis + 0.999 * R * e));

@@ -105,7 +105,16 @@ struct TreeGrids {
 /// whole forests as one value; near 1e308 OpenVDB cannot invert its transform).
 void checkVoxelSize(double voxelSize_cm);
 
-/// Voxelizes the boughs (not the branches: the tracers draw those as cylinders). Boughs are
+/// Points per voxel edge at which the bake averages a bough of radius R = l sin(phi) over a
+/// voxel's box: 1 (the voxel's centre alone) while the voxel is at most R / 4 wide, else
+/// ceil(h / (R / 4)), at most 32. Where it is more than 1, every voxel that one of the points
+/// of a bough's region falls in is filled: the bough's voxels reach about half a voxel
+/// further than their centres do.
+int boxPointsPerEdge(double boughRadius_cm, double voxelSize_cm);
+
+/// Voxelizes the boughs (not the branches: the tracers draw those as cylinders). Each voxel
+/// holds a bough's mean extinction over its box (boxPointsPerEdge), and where boughs overlap
+/// their sum (bake/README.md). Boughs are
 /// split among TBB threads; the result does not depend on the split (ties keep the bough listed
 /// first). Throws BakeError for a voxel size checkVoxelSize refuses, pyramid levels
 /// outside [1, 16], or a bough outside its domain (non-finite, phi outside (0, pi/2], a
