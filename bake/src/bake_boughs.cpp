@@ -128,14 +128,26 @@ std::optional<LayerSample> voxelSample(const PreparedBough& b, const openvdb::Co
     return b.sampleAcross(centre);
 }
 
+/// A voxel's points' opacities are averaged over the mean chord of the voxel under isotropic
+/// lines, 4 V / S = 2 h / 3 for a cube (Cauchy), in voxel sizes.
+constexpr double kMeanChordOverSize = 2.0 / 3.0;
+
 /// Writes the keys of one bough's voxels, keeping larger keys already there, and adds its
-/// mean extinction over each voxel's box (its n^3 points, boxPoint) to the voxel's sum.
+/// extinction to each voxel's sum: the field's at the voxel's centre for n = 1; for n > 1 the
+/// extinction whose opacity over the voxel's mean chord l is the mean over its n^3 points
+/// (boxPoint) of each point's own, 1 - exp(-sigma_i l), 0 outside the region. A line across
+/// the voxel meets the needles about where it passes, and lets through about exp(-sigma_i l)
+/// there, so the voxel lets through as much light as the needles do on average. Where the
+/// bough fills the voxel evenly that is its extinction; where it fills part of it, less than
+/// its mean, which spread evenly would cover more than the needles (1 - exp(-x) is concave;
+/// bake/README.md has the forest's numbers).
 void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLaw& law, double h,
                    openvdb::Int64Grid::Accessor& keys, openvdb::FloatGrid::Accessor& sums)
 {
     if (b.empty()) return;
     const int n = boxPointsPerEdge(b.radius_cm(), h);
     const double cell = h / n;  // the points' cells: voxel k's are k n + c, c in [0, n)
+    const double chord = kMeanChordOverSize * h;
     // A cell whose point is in the region has its centre within half a diagonal of it (for
     // n = 1 the point is the centre).
     const double margin = n == 1 ? 0.0 : 0.5 * std::sqrt(3.0) * cell;
@@ -174,7 +186,8 @@ void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLa
                             b.sample(voxelCentre(ijk, h) +
                                      h * boxPoint(ijk, x, y, int(g - std::int64_t(k) * n), n));
                         if (!s) continue;
-                        column[std::size_t(k - k0)] += law.meanExtinction(*s);
+                        const double sigma = law.meanExtinction(*s);
+                        column[std::size_t(k - k0)] += n == 1 ? sigma : -std::expm1(-sigma * chord);
                         any = true;
                     }
                 }
@@ -182,13 +195,16 @@ void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLa
             if (!any) continue;
             for (int k = k0; k <= k1; ++k) {
                 double& sum = column[std::size_t(k - k0)];
-                const double mean = sum / (double(n) * n * n);
+                // An opacity that rounds to 1 stays finite: 27.6 / l.
+                const double extinction =
+                    n == 1 ? sum
+                           : -std::log1p(-std::min(sum / (double(n) * n * n), 1.0 - 1e-12)) / chord;
                 sum = 0.0;
-                if (!(mean > 0.0)) continue;
+                if (!(extinction > 0.0)) continue;
                 const openvdb::Coord ijk(i, j, k);
-                const std::int64_t key = voxelKey(mean, index);
+                const std::int64_t key = voxelKey(extinction, index);
                 if (key > keys.getValue(ijk)) keys.setValue(ijk, key);
-                sums.setValue(ijk, sums.getValue(ijk) + float(mean));
+                sums.setValue(ijk, sums.getValue(ijk) + float(extinction));
             }
         }
     }

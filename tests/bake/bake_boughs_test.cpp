@@ -89,43 +89,68 @@ TEST(BakeBoughs, MassOfALongBoughMatchesTheIntegral)
 
 TEST(BakeBoughs, CoarseVoxelsKeepTheBoughsExtinction)
 {
-    // A voxel wider than a quarter of R holds the field's mean over its box, so that the mass
-    // stays the integral's (as in MassOfALongBoughMatchesTheIntegral) however coarse the
-    // voxels. Two boughs: one whose axis runs along a lattice axis through voxel centres, where
-    // centres alone lose whole rows (a 2R bake of it was empty, every centre on the axis or
-    // beyond R), and an oblique one. And every voxel's layered fields meet its density, under
-    // each law, as the reference reads them.
+    // A voxel wider than R / 4 holds the extinction whose opacity over its mean chord is the
+    // mean of its points' own. Three consequences, each checked from R / 2 to 4R, for a bough
+    // whose axis runs along a lattice axis through voxel centres (where centres alone lose
+    // whole rows: a 2R bake of it was empty, every centre on the axis or beyond R) and an
+    // oblique one:
+    // - needles so thin that every opacity is linear in the extinction: the mean over the box,
+    //   so the mass is the integral's (MassOfALongBoughMatchesTheIntegral);
+    // - a voxel the paper's bough fills wholly keeps its extinction, uniform there;
+    // - every voxel's layered fields meet its density, under each law, as the reference reads
+    //   them.
     const double L = 60.0;
     for (const Vec3& axis : {Vec3(1, 0, 0), Vec3(0.3, 0.5, 0.8)}) {
-        const BoughSpec b = test::paperBough(Vec3(0.0), axis, L);
-        const analytic::ConeGeometry& c = b.needles.cone;
+        const BoughSpec paper = test::paperBough(Vec3(0.0), axis, L);
+        BoughSpec thin = paper;
+        thin.needles.cone.needleRadius_cm = 5e-5;  // A = 2.3e-4, mean extinction 3.4e-4 / cm
+        const analytic::ConeGeometry& c = thin.needles.cone;
         const double phi = c.aperture_rad, R = c.needleLength_cm * std::sin(phi);
         const double mu = -std::log(1.0 - 2.0 * c.needlesPerCone * c.needleRadius_cm / (kPi * R));
         const double exact =
-            mu / (2.0 * b.needles.coneSpacing_cm * std::sin(phi)) * kPi * R * R * L;
+            mu / (2.0 * thin.needles.coneSpacing_cm * std::sin(phi)) * kPi * R * R * L;
         for (const double h : {R / 2, R, 2 * R, 4 * R}) {
+            EXPECT_NEAR(voxelizedMass(bakeBoughs({thin}, BakeSettings{h, 1, "layer"})) / exact, 1.0,
+                        0.015)
+                << "axis " << axis.x << " h " << h;
             for (const char* name : {"layer", "fibre"}) {
-                const TreeGrids g = bakeBoughs({b}, BakeSettings{h, 1, name});
-                if (std::string(name) == "layer") {
-                    EXPECT_NEAR(voxelizedMass(g) / exact, 1.0, 0.015)
-                        << "axis " << axis.x << " h " << h;
-                }
+                const TreeGrids g = bakeBoughs({paper}, BakeSettings{h, 1, name});
                 const ExtinctionLaw& law = extinctionLaw(name);
                 auto gradient = g.layerGradient->getConstAccessor();
                 auto needle = g.needleDirection->getConstAccessor();
                 auto opacity = g.layerOpacity->getConstAccessor();
                 auto coverage = g.needleCoverage->getConstAccessor();
+                int whole = 0;
                 for (auto it = g.density->cbeginValueOn(); it; ++it) {
                     const openvdb::Coord ijk = it.getCoord();
-                    LayerSample s;
                     const auto vec = [](const openvdb::Vec3s& v) {
                         return Vec3(v.x(), v.y(), v.z());
                     };
+                    LayerSample s;
                     s.gradient = vec(gradient.getValue(ijk));
                     s.needle = vec(needle.getValue(ijk));
                     s.layerOpacity = opacity.getValue(ijk);
                     s.needleCoverage = coverage.getValue(ijk);
                     ASSERT_NEAR(law.meanExtinction(s), *it, 1e-5 * *it) << name << " " << ijk;
+                    if (std::string(name) != "layer") continue;
+                    // Wholly inside: every corner within R of the axis (a disc is convex), and
+                    // the voxel well clear of the bough's ends.
+                    const Vec3 centre = h * Vec3(ijk.x(), ijk.y(), ijk.z());
+                    bool inside = glm::dot(centre, axis) > 8.0 && glm::dot(centre, axis) < L - 8.0;
+                    for (int corner = 0; corner < 8 && inside; ++corner) {
+                        const Vec3 x = centre + 0.5 * h *
+                                                    Vec3(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1,
+                                                         corner & 4 ? 1 : -1);
+                        inside = glm::length(x - glm::dot(x, axis) * axis) < R;
+                    }
+                    if (!inside) continue;
+                    ++whole;
+                    const auto field = sampleBough(paper, centre);
+                    ASSERT_TRUE(field);
+                    ASSERT_NEAR(*it, law.meanExtinction(*field), 1e-5 * *it) << ijk;
+                }
+                if (std::string(name) == "layer" && h <= R / 2) {
+                    EXPECT_GT(whole, 10) << "axis " << axis.x;
                 }
             }
         }
