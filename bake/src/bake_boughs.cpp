@@ -100,8 +100,9 @@ std::uint64_t hashBits(std::uint64_t a, std::uint64_t b)
 /// Point (x, y, z) of voxel ijk's n^3, as an offset from its centre in units of h: the centre
 /// for n = 1, else one point in each of the n^3 cells of the box, placed in its cell by a hash
 /// of the voxel and the cell. A lattice of points lined up with the voxels', as the centres
-/// are, errs the same way all along a branch lined up with it (a disc of radius R counts
-/// 3.25 R^2 on a square lattice R / 4 apart through its centre, 3.4% more than pi R^2); the
+/// are, errs the same way all along a branch lined up with it (a disc of radius R holds
+/// 3.25 R^2 of a square lattice R / 4 apart set symmetrically about its centre, 3.4% more
+/// than pi R^2); the
 /// hashed points err at random, and their errors cancel over the voxels. They are the same
 /// points on every machine and thread.
 Vec3 boxPoint(const openvdb::Coord& ijk, int x, int y, int z, int n)

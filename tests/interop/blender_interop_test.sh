@@ -4,8 +4,8 @@
 # coverage (alpha) compared with the fibre-law reference render of the same view from the same
 # grids. Blender renders `density` as an isotropic medium (the needles placed independently),
 # the reference the needles evenly spaced in their cones, so the two differ by what that
-# choice makes (measured: coverage -1.2%, per-pixel mean |alpha difference| 0.0095 at 96 x 72,
-# -1.0% and 0.010 at 320 x 240);
+# choice makes (measured: coverage -2.0%, per-pixel mean |alpha difference| 0.0093 at 96 x 72,
+# -2.1% and 0.0096 at 320 x 240);
 # the bounds below are about twice that. A misplaced tree (transform, frame), a density in the
 # wrong unit or a missing mesh breaks them by a factor of several.
 # Usage: blender_interop_test.sh BAKE VDBTRACE SOURCE_DIR [KEEP_DIR WIDTH HEIGHT]
