@@ -27,7 +27,7 @@ using detail::PreparedBough;
 
 /// Which bough a voxel keeps, as one integer so that the runs' grids merge by a plain max
 /// (tools::compMax) and the result does not depend on how boughs were split among them:
-/// the larger mean extinction wins (high word: the float's bits, ordered as the floats are for
+/// the larger extinction wins (high word: the float's bits, ordered as the floats are for
 /// positive values), and of equal ones the bough listed first (low word: ~index).
 std::int64_t voxelKey(double meanExtinction, std::size_t bough)
 {
@@ -100,11 +100,10 @@ std::uint64_t hashBits(std::uint64_t a, std::uint64_t b)
 /// Point (x, y, z) of voxel ijk's n^3, as an offset from its centre in units of h: the centre
 /// for n = 1, else one point in each of the n^3 cells of the box, placed in its cell by a hash
 /// of the voxel and the cell. A lattice of points lined up with the voxels', as the centres
-/// are, errs the same way all along a branch lined up with it (a disc of radius R holds
-/// 3.25 R^2 of a square lattice R / 4 apart set symmetrically about its centre, 3.4% more
-/// than pi R^2); the
-/// hashed points err at random, and their errors cancel over the voxels. They are the same
-/// points on every machine and thread.
+/// are, errs the same way all along a branch lined up with it (a disc of radius R holds 3.25
+/// R^2 of a square lattice R / 4 apart half a step off its centre, 3.4% more than pi R^2, and
+/// 3.06 R^2 of one through its centre, 2.5% less); the hashed points err at random, and their
+/// errors cancel over the voxels. They are the same points on every machine and thread.
 Vec3 boxPoint(const openvdb::Coord& ijk, int x, int y, int z, int n)
 {
     if (n == 1) return Vec3(0.0);
@@ -161,14 +160,15 @@ void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLa
         lo[i] = std::min(p0[i], p1[i]) - widen;
         hi[i] = std::max(p0[i], p1[i]) + widen;
     }
-    // One voxel of slack on each side, and one cell below: the exact test is sample()'s.
+    // One voxel of slack around the box, one cell at each end of a column's interval: the
+    // exact test is sample()'s.
     const auto first = [h](double v) { return int(std::ceil(v / h)) - 1; };
     const auto last = [h](double v) { return int(std::floor(v / h)) + 1; };
     const int k0 = first(lo.z), k1 = last(hi.z);
     std::vector<double> column(std::size_t(k1 - k0 + 1), 0.0);  // per voxel: its points' sum
     for (int i = first(lo.x); i <= last(hi.x); ++i) {
         for (int j = first(lo.y); j <= last(hi.y); ++j) {
-            bool any = false;
+            int low = k1 + 1, high = k0 - 1;  // the voxels of this column a point was in
             for (int x = 0; x < n; ++x) {
                 for (int y = 0; y < n; ++y) {
                     // The line through the centres of this column of cells.
@@ -189,12 +189,12 @@ void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLa
                         if (!s) continue;
                         const double sigma = law.meanExtinction(*s);
                         column[std::size_t(k - k0)] += n == 1 ? sigma : -std::expm1(-sigma * chord);
-                        any = true;
+                        low = std::min(low, k);
+                        high = std::max(high, k);
                     }
                 }
             }
-            if (!any) continue;
-            for (int k = k0; k <= k1; ++k) {
+            for (int k = low; k <= high; ++k) {
                 double& sum = column[std::size_t(k - k0)];
                 // An opacity that rounds to 1 stays finite: 27.6 / l.
                 const double extinction =
@@ -211,7 +211,7 @@ void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLa
     }
 }
 
-/// Per voxel, the bough it keeps (its key) and the sum of every bough's mean extinction there.
+/// Per voxel, the bough it keeps (its key) and the sum of every bough's extinction there.
 struct VoxelKeys {
     openvdb::Int64Grid::Ptr keys = openvdb::Int64Grid::create(0);
     openvdb::FloatGrid::Ptr sums = openvdb::FloatGrid::create(0.0f);  // floats: the grids' own
@@ -273,13 +273,13 @@ int boxPointsPerEdge(double boughRadius_cm, double voxelSize_cm)
     // Read at its centre alone, a voxel wider than R / 4 misses or doubles whole rows of a
     // bough: a straight branch whose axis ran through voxel centres kept 0.73 of its
     // extinction at 1 cm and nothing at 2 cm, a fir lost 1.4% at 2 cm and 4.8% at 4 cm. With
-    // the points never further apart than R / 4, a bake samples about as many points as one
-    // at R / 4, whatever its voxel size (MassOfALongBoughMatchesTheIntegral holds the centres
-    // to the mass down to there).
+    // one point in each cell at most R / 4 wide (up to h = 8R), a bake samples about as many
+    // points as one at R / 4, whatever its voxel size (MassOfALongBoughMatchesTheIntegral
+    // holds the centres to the mass down to there; the 1e-9 keeps h = R / 4 on them).
     constexpr double kMostSpacingOverRadius = 0.25;
     constexpr int kMost = 32;  // 32^3 points a voxel, for voxels 8 R wide and more
     const double n = std::ceil(voxelSize_cm / (kMostSpacingOverRadius * boughRadius_cm) - 1e-9);
-    return n <= 1.0 ? 1 : int(std::min(n, double(kMost)));
+    return n > 1.0 ? int(std::min(n, double(kMost))) : 1;  // 1 for a NaN radius too
 }
 
 void checkVoxelSize(double voxelSize_cm)
@@ -323,12 +323,15 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
     const auto xform = openvdb::math::Transform::createLinearTransform(h);
     for (const FieldInfo& info : kFields) out.setGrid(info.field, makeGrid(info, xform));
 
-    // Each kept voxel, filled from its bough at the voxel's centre. Where boughs overlap,
-    // their needles are all there (a bough's region holds only the needles of its own cones,
-    // so a chain's boughs do not overlap): the density is their summed mean extinction, and the
-    // layered fields, which hold one bough's layers, are the densest bough's with its layer
-    // gradient scaled by the sum over its own mean. Every law is linear in |layer_gradient|
-    // (layers per cm), so the reference meets the summed mean extinction there; per direction
+    // Each kept voxel, filled from its bough's field at the voxel's centre (voxelSample). Where
+    // boughs overlap, their needles are all there (a bough's region holds only the needles of
+    // its own cones, so a chain's boughs do not overlap): the density is the sum of their
+    // extinctions, and the layered fields, which hold one bough's layers, are the densest
+    // bough's with its layer gradient scaled by the sum over its own mean. Every law is linear
+    // in |layer_gradient| (layers per cm), so the reference meets the summed extinction there.
+    // (In a voxel wider than R / 4, boughs that fill disjoint parts of it are summed as if they
+    // overlapped: parts p and q of opacities a and b let through (1 - pa)(1 - qb), not 1 - pa
+    // - qb; bake/README.md.) Per direction
     // it keeps the densest bough's anisotropy (its needles' and layers' directions), and under
     // the banded law each band meets as many needles, the bands being more.
     auto density = out.density->getAccessor();
@@ -342,8 +345,9 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
         const std::size_t b = boughOfKey(*it);
         auto s = voxelSample(prepared[b], ijk, h);
         if (!s) continue;  // cannot happen: the bough, which wrote the key, is not empty
-        // One bough's sum is its own mean rounded to a float (as the density always was): then
-        // the sample is kept exactly, as is a sum that others change by less than a float can.
+        // A voxel read at its centre, of one bough, sums its own mean rounded to a float (as the
+        // density always was): then the sample is kept exactly, as is a sum that others change
+        // by less than a float can. A box's (n > 1) is its opacity's extinction, so rescaled.
         const double own = law.meanExtinction(*s);
         const float sum = sums.getValue(ijk);
         if (sum != float(own)) s->gradient *= double(sum) / own;

@@ -55,8 +55,8 @@ PreparedBough::PreparedBough(const BoughSpec& spec)
 
     mBase = spec.base_cm;
     mLength = glm::length(spec.tip_cm - spec.base_cm);
-    mRadius = analytic::boughRadius(cone);      // R = l sin(phi)
-    mOpacity = analytic::layerOpacity(cone);    // A = 2 N r / (pi R), in [0, 1]
+    mRadius = analytic::boughRadius(cone);    // R = l sin(phi)
+    mOpacity = analytic::layerOpacity(cone);  // A = 2 N r / (pi R), in [0, 1]
     mCoverageTimesRho = cone.needlesPerCone * cone.needleRadius_cm / analytic::kPi;
     mCosPhi = std::cos(phi);
     mSinPhi = std::sin(phi);

@@ -109,6 +109,25 @@ std::map<std::string, SpeciesSample> samples(const scenes::Scene& scene,
     return bySpecies;
 }
 
+/// The cylinder of the voxels a bough fills at h: half a voxel wider (up to half a diagonal)
+/// where the bake averages voxels' boxes, which fills every voxel one of whose points is inside.
+BoughCylinder filledBy(const BoughCylinder& b, double h)
+{
+    if (boxPointsPerEdge(b.radius_cm, h) == 1) return b;
+    return BoughCylinder{b.base - 0.5 * h * b.axis, b.axis, b.extent_cm + h, b.radius_cm + 0.5 * h};
+}
+
+/// The volume of the voxels a tree's boughs fill at h, cm^3.
+double filledVolume_cm3(const SpeciesSample& tree, double h)
+{
+    double volume = 0.0;
+    for (const BoughCylinder& bough : tree.boughs) {
+        const BoughCylinder b = filledBy(bough, h);
+        volume += kPi * b.radius_cm * b.radius_cm * b.extent_cm;
+    }
+    return volume;
+}
+
 /// The OpenVDB leaves (8^3 voxels of h cm) a tree's boughs reach: points at most a quarter of
 /// a leaf apart through each bough's cylinder, each leaf counted once however many boughs
 /// share it. Where leaves are small against the boughs (more than kMostPoints points), the
@@ -118,19 +137,12 @@ double leavesOf(const SpeciesSample& tree, double h)
 {
     constexpr double kMostPoints = 4e6;
     const double leaf = 8.0 * h, step = 0.25 * leaf;
-    const double filled = tree.totals.boughVolume_cm3 / (leaf * leaf * leaf);
+    const double filled = filledVolume_cm3(tree, h) / (leaf * leaf * leaf);
     // Points across and along a bough: each centred in one of n equal cells at most a step wide.
     const auto cells = [step](double width) { return std::max(1.0, std::ceil(width / step)); };
     double points = 0.0;
-    // The cylinder of the voxels a bough fills: about half a voxel wider where the bake
-    // averages voxels' boxes, which then fills every voxel one of its points inside falls in.
-    const auto filledBy = [h](const BoughCylinder& b) {
-        if (boxPointsPerEdge(b.radius_cm, h) == 1) return b;
-        return BoughCylinder{b.base - 0.5 * h * b.axis, b.axis, b.extent_cm + h,
-                             b.radius_cm + 0.5 * h};
-    };
     for (const BoughCylinder& bough : tree.boughs) {
-        const BoughCylinder b = filledBy(bough);
+        const BoughCylinder b = filledBy(bough, h);
         points += cells(b.extent_cm) * cells(2.0 * b.radius_cm) * cells(2.0 * b.radius_cm);
     }
     if (!(points <= kMostPoints)) return 1.25 * filled;
@@ -146,7 +158,7 @@ double leavesOf(const SpeciesSample& tree, double h)
     // A leaf index a long long cannot hold (tiny leaves far out) falls back to the volume.
     constexpr double kMostIndex = 1e18;
     for (const BoughCylinder& bough : tree.boughs) {
-        const BoughCylinder b = filledBy(bough);
+        const BoughCylinder b = filledBy(bough, h);
         const Vec3 helper = std::abs(b.axis.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
         const Vec3 u = glm::normalize(glm::cross(b.axis, helper)), v = glm::cross(b.axis, u);
         const int along = int(cells(b.extent_cm)), across = int(cells(2.0 * b.radius_cm));
@@ -206,7 +218,7 @@ void addVoxels(ResourceEstimate& e, const std::vector<SampledTrees>& trees, doub
     if (!(voxelSize_cm > 0.0)) return;
     double voxels = 0.0, leaves = 0.0;
     for (const SampledTrees& t : trees) {
-        voxels += t.count * t.sample->totals.boughVolume_cm3 / std::pow(voxelSize_cm, 3);
+        voxels += t.count * filledVolume_cm3(*t.sample, voxelSize_cm) / std::pow(voxelSize_cm, 3);
         leaves += t.count * leavesOf(*t.sample, voxelSize_cm);
     }
     char size[32];
@@ -359,7 +371,10 @@ double defaultMemoryLimit()
     return 0.8 * double(pages) * double(size);
 }
 
-double memoryLimit(double gib) { return gib > 0.0 ? gib * kGiB : defaultMemoryLimit(); }
+double memoryLimit(double gib)
+{
+    return gib > 0.0 ? gib * kGiB : defaultMemoryLimit();
+}
 
 std::string formatCount(double n)
 {

@@ -5,8 +5,8 @@
 
 #include "test_support.h"
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include <tbb/task_arena.h>
 
@@ -17,7 +17,10 @@
 namespace pine::bake {
 namespace {
 
-const ExtinctionLaw& layerLaw() { return extinctionLaw("layer"); }
+const ExtinctionLaw& layerLaw()
+{
+    return extinctionLaw("layer");
+}
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -68,9 +71,9 @@ TEST(BakeBoughs, MassOfALongBoughMatchesTheIntegral)
         double sumError = 0.0;
         for (int k = 0; k < kShifts; ++k) {
             // Sub-voxel shifts of the bough: a deterministic low-discrepancy set.
-            const Vec3 shift = h * Vec3(std::fmod(0.5 + k * 0.618034, 1.0),
-                                        std::fmod(0.5 + k * 0.754878, 1.0),
-                                        std::fmod(0.5 + k * 0.569840, 1.0));
+            const Vec3 shift =
+                h * Vec3(std::fmod(0.5 + k * 0.618034, 1.0), std::fmod(0.5 + k * 0.754878, 1.0),
+                         std::fmod(0.5 + k * 0.569840, 1.0));
             BoughSpec shifted = b;
             shifted.base_cm += shift;
             shifted.tip_cm += shift;
@@ -100,7 +103,7 @@ TEST(BakeBoughs, CoarseVoxelsKeepTheBoughsExtinction)
     // - every voxel's layered fields meet its density, under each law, as the reference reads
     //   them.
     const double L = 60.0;
-    for (const Vec3& axis : {Vec3(1, 0, 0), Vec3(0.3, 0.5, 0.8)}) {
+    for (const Vec3& axis : {Vec3(1, 0, 0), glm::normalize(Vec3(0.3, 0.5, 0.8))}) {
         const BoughSpec paper = test::paperBough(Vec3(0.0), axis, L);
         BoughSpec thin = paper;
         thin.needles.cone.needleRadius_cm = 5e-5;  // A = 2.3e-4, mean extinction 3.4e-4 / cm
@@ -113,7 +116,7 @@ TEST(BakeBoughs, CoarseVoxelsKeepTheBoughsExtinction)
             EXPECT_NEAR(voxelizedMass(bakeBoughs({thin}, BakeSettings{h, 1, "layer"})) / exact, 1.0,
                         0.015)
                 << "axis " << axis.x << " h " << h;
-            for (const char* name : {"layer", "fibre"}) {
+            for (const char* name : {"layer", "fibre", "poisson"}) {
                 const TreeGrids g = bakeBoughs({paper}, BakeSettings{h, 1, name});
                 const ExtinctionLaw& law = extinctionLaw(name);
                 auto gradient = g.layerGradient->getConstAccessor();
@@ -177,6 +180,20 @@ openvdb::CoordBBox searchBox(const BoughSpec& b, double h)
     }
     box.expand(1);
     return box;
+}
+
+TEST(BakeBoughs, VoxelsWiderThanAQuarterOfTheRadiusAverageTheirBoxes)
+{
+    // One point (the centre) up to R / 4, then cells at most R / 4 wide, up to 32 a side.
+    const double R = 1.6;
+    EXPECT_EQ(boxPointsPerEdge(R, R / 8), 1);
+    EXPECT_EQ(boxPointsPerEdge(R, R / 4), 1);
+    EXPECT_EQ(boxPointsPerEdge(R, R / 4 * 1.001), 2);
+    EXPECT_EQ(boxPointsPerEdge(R, R), 4);
+    EXPECT_EQ(boxPointsPerEdge(R, R * 1.1), 5);
+    EXPECT_EQ(boxPointsPerEdge(R, 8 * R), 32);
+    EXPECT_EQ(boxPointsPerEdge(R, 100 * R), 32);
+    EXPECT_EQ(boxPointsPerEdge(std::nan(""), 1.0), 1);
 }
 
 TEST(BakeBoughs, PoissonMassIsTheNeedlesMeanProjectedArea)

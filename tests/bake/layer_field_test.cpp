@@ -1,12 +1,12 @@
 // The layer field against what it stands for: cones counted one by one along a ray, and the
 // mean over directions by quadrature on the sphere.
-#include "pine/bake/extinction_law.h"
 #include "pine/bake/layer_field.h"
+#include "pine/bake/extinction_law.h"
 
 #include "test_support.h"
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include <cmath>
 #include <vector>
@@ -14,11 +14,17 @@
 namespace pine::bake {
 namespace {
 
-const ExtinctionLaw& layerLaw() { return extinctionLaw("layer"); }
+const ExtinctionLaw& layerLaw()
+{
+    return extinctionLaw("layer");
+}
 
 constexpr double kPi = 3.14159265358979323846;
 
-Vec3 unit(double x, double y, double z) { return glm::normalize(Vec3(x, y, z)); }
+Vec3 unit(double x, double y, double z)
+{
+    return glm::normalize(Vec3(x, y, z));
+}
 
 /// Any unit vector orthogonal to unit `a`.
 Vec3 perpendicular(const Vec3& a)

@@ -83,7 +83,7 @@ with tempfile.TemporaryDirectory() as work:
         os.mkdir(folder)
     for trial in range(count):
         data = damaged(original, trial)
-        while data == original:  # zeros written over zeros: no damage, drawn again
+        while data == original:  # zeros over zeros, 0x7f over 0x7f: no damage, drawn again
             data = damaged(original, trial)
         name = "t%03d.vdb" % trial
         for situation, folder in folders.items():

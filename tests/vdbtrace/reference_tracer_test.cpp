@@ -1,17 +1,18 @@
 // The reference method: equation (7) through baked grids against a closed form of the same
 // continuous field, its convergence in the voxel size, and its edge cases.
+#include "pine/vdbtrace/reference_tracer.h"
 #include "pine/analytic/bough_shader.h"
 #include "pine/analytic/cone_shader.h"
 #include "pine/analytic/true_cone_bough.h"
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/cone_camera.h"
 #include "pine/vdbtrace/image_diff.h"
-#include "pine/vdbtrace/reference_tracer.h"
 
 #include <gtest/gtest.h>
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace pine::vdbtrace {
@@ -48,9 +49,8 @@ struct SideOn {
         d.spec.tip_cm = 20.0 * axis;
         d.spec.needles = analytic::paperBough();
         d.spec.needleAlbedo = Vec3(0.3);
-        traced.boughs.push_back(
-            makeTracedBough(d, scene.camera.position_cm, traced.lights, boughLaw("linear"),
-                            *traced.layers));
+        traced.boughs.push_back(makeTracedBough(d, scene.camera.position_cm, traced.lights,
+                                                boughLaw("linear"), *traced.layers));
         specs.push_back(d.spec);
     }
 };
@@ -74,8 +74,8 @@ double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
         Passage p;
         if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap > 0.9 * R) continue;
         const double cosV = glm::dot(-ray.direction, b.axis);
-        const double layers =
-            analytic::trueConeLayers(b.geometry, cosV, std::sqrt(1 - cosV * cosV), p.gap / R);
+        const double layers = analytic::trueConeLayers(
+            b.geometry, cosV, std::sqrt(std::max(0.0, 1 - cosV * cosV)), p.gap / R);
         sum += std::abs(r.image.pixel(camera.width() / 2, y)[3] - (1.0 - std::exp(-mu * layers)));
         ++rows;
     }
@@ -118,15 +118,12 @@ std::pair<double, double> stripOpacity(const SideOn& s, double voxel)
     double got = 0.0, want = 0.0;
     for (int y = 0; y < camera.height(); ++y) {
         const ConeRay ray = camera.cone(camera.width() / 2, y);
-        Passage p;
-        if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap > R) {
-            got += r.image.pixel(camera.width() / 2, y)[3];
-            continue;
-        }
-        const double cosV = glm::dot(-ray.direction, b.axis);
-        const double layers =
-            analytic::trueConeLayers(b.geometry, cosV, std::sqrt(1 - cosV * cosV), p.gap / R);
         got += r.image.pixel(camera.width() / 2, y)[3];
+        Passage p;
+        if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap > R) continue;
+        const double cosV = glm::dot(-ray.direction, b.axis);
+        const double layers = analytic::trueConeLayers(
+            b.geometry, cosV, std::sqrt(std::max(0.0, 1 - cosV * cosV)), p.gap / R);
         want += 1.0 - std::exp(-mu * layers);
     }
     return {got, want};

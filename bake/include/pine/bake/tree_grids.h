@@ -35,8 +35,8 @@ enum class Field {
 
 struct FieldInfo {
     Field field;
-    const char* name;             ///< the grid's name in the file
-    bool vector;                  ///< a Vec3SGrid (in world space), else a FloatGrid
+    const char* name;  ///< the grid's name in the file
+    bool vector;       ///< a Vec3SGrid (in world space), else a FloatGrid
     /// How a tool must transform the vectors with the grid: G = grad g / dh is a gradient
     /// (covariant: by the inverse transpose), the needle a direction (contravariant), the
     /// albedo a colour (invariant).
@@ -108,12 +108,13 @@ void checkVoxelSize(double voxelSize_cm);
 /// Points per voxel edge at which the bake averages a bough of radius R = l sin(phi) over a
 /// voxel's box: 1 (the voxel's centre alone) while the voxel is at most R / 4 wide, else
 /// ceil(h / (R / 4)), at most 32. Where it is more than 1, every voxel that one of the points
-/// of a bough's region falls in is filled: the bough's voxels reach about half a voxel
-/// further than their centres do.
+/// of a bough's region falls in is filled: the bough's voxels reach about half a voxel (up to
+/// half a diagonal) further than their centres do.
 int boxPointsPerEdge(double boughRadius_cm, double voxelSize_cm);
 
 /// Voxelizes the boughs (not the branches: the tracers draw those as cylinders). Each voxel
-/// holds a bough's mean extinction over its box (boxPointsPerEdge), and where boughs overlap
+/// holds a bough's extinction at its centre, or over its box (boxPointsPerEdge: the extinction
+/// whose opacity over its mean chord 2h/3 is its points' mean opacity), and where boughs overlap
 /// their sum (bake/README.md). Boughs are
 /// split among TBB threads; the result does not depend on the split (ties keep the bough listed
 /// first). Throws BakeError for a voxel size checkVoxelSize refuses, pyramid levels
@@ -137,7 +138,10 @@ enum class LengthUnit { Centimetre, Metre };
 /// "cm" or "m"; lengthUnit throws BakeError for another name.
 const char* unitName(LengthUnit unit);
 LengthUnit lengthUnit(const std::string& name);
-inline double centimetresPer(LengthUnit unit) { return unit == LengthUnit::Metre ? 100.0 : 1.0; }
+inline double centimetresPer(LengthUnit unit)
+{
+    return unit == LengthUnit::Metre ? 100.0 : 1.0;
+}
 
 /// Where a tree stands in its scene: the origin of its own frame at its base, and its rotation
 /// about z (scenes::TreePlacement).
