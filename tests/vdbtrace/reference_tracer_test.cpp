@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace pine::vdbtrace {
 namespace {
@@ -55,10 +56,12 @@ struct SideOn {
     }
 };
 
-// Mean absolute error of the rows' opacity (the central column) against analytic's true-cone
-// bough: each row's ray at offset u = gap / R from the axis crosses trueConeLayers of them, so
-// its opacity is 1 - exp(-mu layers) (analytic/true_cone_bough.h).
-double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
+// The bough baked at `voxel` and rendered by the reference, down the central column: each
+// row's opacity, and analytic's true-cone bough's where the row's ray passes the axis within
+// reachOverR R (at offset u = gap / R it crosses trueConeLayers of the cones, so its opacity is
+// 1 - exp(-mu layers), analytic/true_cone_bough.h), else nothing.
+template <class Row>
+void forEachRow(const SideOn& s, double voxel, double reachOverR, Row&& row)
 {
     const bake::TreeGrids grids = bake::bakeBoughs(s.specs, paperBake(voxel));
     ReferenceOptions options;
@@ -67,18 +70,32 @@ double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
     const TracedBough& b = s.traced.boughs.front();
     const ConeCamera camera(s.scene.camera);
     const double mu = -std::log1p(-b.layerOpacity), R = b.radius_cm;
-    double sum = 0.0;
-    int rows = 0;
     for (int y = 0; y < camera.height(); ++y) {
+        const double rendered = r.image.pixel(camera.width() / 2, y)[3];
         const ConeRay ray = camera.cone(camera.width() / 2, y);
         Passage p;
-        if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap > 0.9 * R) continue;
+        if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap > reachOverR * R) {
+            row(rendered, std::optional<double>());
+            continue;
+        }
         const double cosV = glm::dot(-ray.direction, b.axis);
         const double layers = analytic::trueConeLayers(
             b.geometry, cosV, std::sqrt(std::max(0.0, 1 - cosV * cosV)), p.gap / R);
-        sum += std::abs(r.image.pixel(camera.width() / 2, y)[3] - (1.0 - std::exp(-mu * layers)));
-        ++rows;
+        row(rendered, std::optional<double>(1.0 - std::exp(-mu * layers)));
     }
+}
+
+// Mean absolute error of the rows' opacity against analytic's true-cone bough, over the rows
+// within 0.9 R of the axis.
+double rowError(const SideOn& s, double voxel, int* rowsOut = nullptr)
+{
+    double sum = 0.0;
+    int rows = 0;
+    forEachRow(s, voxel, 0.9, [&](double rendered, std::optional<double> exact) {
+        if (!exact) return;
+        sum += std::abs(rendered - *exact);
+        ++rows;
+    });
     if (rowsOut) *rowsOut = rows;
     return sum / rows;
 }
@@ -105,27 +122,14 @@ TEST(ReferenceTracer, ErrorShrinksWithTheVoxelSize)
 }
 
 // The strip's opacity summed down the central column: the reference's over every row (what
-// it spreads beyond the strip counts), and analytic's true-cone bough's (as rowError).
+// it spreads beyond the strip counts), and analytic's true-cone bough's.
 std::pair<double, double> stripOpacity(const SideOn& s, double voxel)
 {
-    const bake::TreeGrids grids = bake::bakeBoughs(s.specs, paperBake(voxel));
-    ReferenceOptions options;
-    options.subpixels = 1;
-    const RenderResult r = renderReference(s.traced, grids, options);
-    const TracedBough& b = s.traced.boughs.front();
-    const ConeCamera camera(s.scene.camera);
-    const double mu = -std::log1p(-b.layerOpacity), R = b.radius_cm;
     double got = 0.0, want = 0.0;
-    for (int y = 0; y < camera.height(); ++y) {
-        const ConeRay ray = camera.cone(camera.width() / 2, y);
-        got += r.image.pixel(camera.width() / 2, y)[3];
-        Passage p;
-        if (!closestPassage(ray, b.base_cm, b.tip_cm, p) || p.gap > R) continue;
-        const double cosV = glm::dot(-ray.direction, b.axis);
-        const double layers = analytic::trueConeLayers(
-            b.geometry, cosV, std::sqrt(std::max(0.0, 1 - cosV * cosV)), p.gap / R);
-        want += 1.0 - std::exp(-mu * layers);
-    }
+    forEachRow(s, voxel, 1.0, [&](double rendered, std::optional<double> exact) {
+        got += rendered;
+        want += exact.value_or(0.0);
+    });
     return {got, want};
 }
 
