@@ -3,6 +3,7 @@
 // bough, scaled to all the boughs' extinction there.
 #include "pine/bake/tree_grids.h"
 
+#include "box_opacity.h"
 #include "density_pyramid.h"
 #include "pine/bake/extinction_law.h"
 #include "prepared_bough.h"
@@ -23,6 +24,9 @@ namespace pine::bake {
 
 namespace {
 
+using detail::extinctionStopping;
+using detail::kMeanChordOverSize;
+using detail::opacityOver;
 using detail::PreparedBough;
 
 /// Which bough a voxel keeps, as one integer so that the runs' grids merge by a plain max
@@ -128,19 +132,14 @@ std::optional<LayerSample> voxelSample(const PreparedBough& b, const openvdb::Co
     return b.sampleAcross(centre);
 }
 
-/// A voxel's points' opacities are averaged over the mean chord of the voxel under isotropic
-/// lines, 4 V / S = 2 h / 3 for a cube (Cauchy), in voxel sizes.
-constexpr double kMeanChordOverSize = 2.0 / 3.0;
-
 /// Writes the keys of one bough's voxels, keeping larger keys already there, and adds its
 /// extinction to each voxel's sum: the field's at the voxel's centre for n = 1; for n > 1 the
 /// extinction whose opacity over the voxel's mean chord l is the mean over its n^3 points
-/// (boxPoint) of each point's own, 1 - exp(-sigma_i l), 0 outside the region. A line across
-/// the voxel meets the needles about where it passes, and lets through about exp(-sigma_i l)
-/// there, so the voxel lets through as much light as the needles do on average. Where the
-/// bough fills the voxel evenly that is its extinction; where it fills part of it, less than
-/// its mean, which spread evenly would cover more than the needles (1 - exp(-x) is concave;
-/// bake/README.md has the forest's numbers).
+/// (boxPoint) of each point's own, 1 - exp(-sigma_i l), 0 outside the region (box_opacity.h;
+/// l = 2h/3). A line across the voxel meets the needles about where it passes, and lets
+/// through about exp(-sigma_i l) there, so the voxel lets through as much light as the needles
+/// do on average. Where the bough fills the voxel evenly that is its extinction; where it
+/// fills part of it, less than its mean (bake/README.md has the forest's numbers).
 void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLaw& law, double h,
                    openvdb::Int64Grid::Accessor& keys, openvdb::FloatGrid::Accessor& sums)
 {
@@ -188,7 +187,7 @@ void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLa
                                      h * boxPoint(ijk, x, y, int(g - std::int64_t(k) * n), n));
                         if (!s) continue;
                         const double sigma = law.meanExtinction(*s);
-                        column[std::size_t(k - k0)] += n == 1 ? sigma : -std::expm1(-sigma * chord);
+                        column[std::size_t(k - k0)] += n == 1 ? sigma : opacityOver(sigma, chord);
                         low = std::min(low, k);
                         high = std::max(high, k);
                     }
@@ -196,10 +195,8 @@ void voxelizeBough(const PreparedBough& b, std::size_t index, const ExtinctionLa
             }
             for (int k = low; k <= high; ++k) {
                 double& sum = column[std::size_t(k - k0)];
-                // An opacity that rounds to 1 stays finite: 27.6 / l.
                 const double extinction =
-                    n == 1 ? sum
-                           : -std::log1p(-std::min(sum / (double(n) * n * n), 1.0 - 1e-12)) / chord;
+                    n == 1 ? sum : extinctionStopping(sum / (double(n) * n * n), chord);
                 sum = 0.0;
                 if (!(extinction > 0.0)) continue;
                 const openvdb::Coord ijk(i, j, k);

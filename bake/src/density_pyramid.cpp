@@ -1,7 +1,6 @@
 #include "density_pyramid.h"
 
-#include <algorithm>
-#include <cmath>
+#include "box_opacity.h"
 
 namespace pine::bake::detail {
 
@@ -14,7 +13,7 @@ openvdb::FloatGrid::Ptr halveResolution(const openvdb::FloatGrid& fine)
     xform->preScale(2.0);
 
     // The coarse voxel's mean chord, in the grid's length unit (density is per that unit).
-    const double chord = (2.0 / 3.0) * 2.0 * fine.voxelSize()[0];
+    const double chord = kMeanChordOverSize * 2.0 * fine.voxelSize()[0];
     auto coarse = openvdb::FloatGrid::create(0.0f);
     coarse->setTransform(xform);
     auto acc = coarse->getAccessor();
@@ -22,7 +21,7 @@ openvdb::FloatGrid::Ptr halveResolution(const openvdb::FloatGrid& fine)
         // A tile (pruned constant region) stands for all its voxels.
         openvdb::CoordBBox box;
         it.getBoundingBox(box);
-        const float opacity = float(-std::expm1(-double(*it) * chord) * 0.125);
+        const float opacity = float(opacityOver(double(*it), chord) * 0.125);
         for (auto ijk = box.begin(); ijk; ++ijk) {
             // Arithmetic shift: floor division by 2, right for negative indices too.
             const openvdb::Coord c((*ijk).x() >> 1, (*ijk).y() >> 1, (*ijk).z() >> 1);
@@ -30,8 +29,7 @@ openvdb::FloatGrid::Ptr halveResolution(const openvdb::FloatGrid& fine)
         }
     }
     for (auto it = coarse->beginValueOn(); it; ++it) {
-        // An opacity that rounds to 1 stays finite: 27.6 / chord.
-        it.setValue(float(-std::log1p(-std::min(double(*it), 1.0 - 1e-12)) / chord));
+        it.setValue(float(extinctionStopping(double(*it), chord)));
     }
     return coarse;
 }
