@@ -16,6 +16,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -337,6 +338,14 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
     auto needle = out.needleDirection->getAccessor();
     auto coverage = out.needleCoverage->getAccessor();
     auto albedo = out.needleAlbedo->getAccessor();
+    const bool treesKnown =
+        std::any_of(boughs.begin(), boughs.end(), [](const BoughSpec& b) { return b.tree >= 0; });
+    if (treesKnown) {
+        out.tree = openvdb::Int32Grid::create(-1);
+        out.tree->setTransform(xform->copy());
+    }
+    std::optional<openvdb::Int32Grid::Accessor> tree;
+    if (treesKnown) tree = out.tree->getAccessor();
     for (auto it = keys->cbeginValueOn(); it; ++it) {
         const openvdb::Coord ijk = it.getCoord();
         const std::size_t b = boughOfKey(*it);
@@ -357,11 +366,13 @@ TreeGrids bakeBoughs(const std::vector<BoughSpec>& boughs, const BakeSettings& s
         needle.setValue(ijk, vec(s->needle));
         coverage.setValue(ijk, float(s->needleCoverage));
         albedo.setValue(ijk, vec(boughs[b].needleAlbedo));
+        if (tree) tree->setValue(ijk, boughs[b].tree);
     }
 
     openvdb::tools::prune(out.density->tree());
     openvdb::tools::prune(out.layerOpacity->tree());
     openvdb::tools::prune(out.needleAlbedo->tree());
+    if (out.tree) openvdb::tools::prune(out.tree->tree());
 
     openvdb::FloatGrid::Ptr previous = out.density;
     for (int level = 1; level < settings.pyramidLevels; ++level) {

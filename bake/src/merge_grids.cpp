@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace pine::bake {
 namespace {
@@ -32,7 +33,8 @@ void fillInactive(const FieldInfo& info, const TreeGrids& into, const TreeGrids&
 
 /// Where `from` and the trees before it (`occupied`) both hold a voxel, their needles are all
 /// there, as where one tree's boughs overlap (bakeBoughs): the densities add, and the layered
-/// fields are the denser tree's there, its layer gradient scaled by the sum over its own.
+/// fields are the denser tree's there, its layer gradient scaled by the sum over its own, and
+/// the voxel is the denser tree's (TreeGrids::tree).
 void addOverlaps(const TreeGrids& into, const TreeGrids& from, const openvdb::FloatGrid& occupied)
 {
     auto density = into.density->getAccessor();
@@ -47,6 +49,10 @@ void addOverlaps(const TreeGrids& into, const TreeGrids& from, const openvdb::Fl
     const auto theirNeedle = from.needleDirection->getConstAccessor();
     const auto theirCoverage = from.needleCoverage->getConstAccessor();
     const auto theirAlbedo = from.needleAlbedo->getConstAccessor();
+    std::optional<openvdb::Int32Grid::Accessor> tree;
+    std::optional<openvdb::Int32Grid::ConstAccessor> theirTree;
+    if (into.tree) tree = into.tree->getAccessor();
+    if (from.tree) theirTree = from.tree->getConstAccessor();
     for (auto it = from.density->cbeginValueOn(); it; ++it) {
         if (!it.isVoxelValue()) continue;
         const openvdb::Coord c = it.getCoord();
@@ -58,6 +64,7 @@ void addOverlaps(const TreeGrids& into, const TreeGrids& from, const openvdb::Fl
             needle.setValue(c, theirNeedle.getValue(c));
             coverage.setValue(c, theirCoverage.getValue(c));
             albedo.setValue(c, theirAlbedo.getValue(c));
+            if (tree) tree->setValue(c, theirTree ? theirTree->getValue(c) : -1);
         }
         const float kept = std::max(mine, theirs);
         if (kept > 0.0f) gradient.setValue(c, gradient.getValue(c) * (sum / kept));
@@ -77,6 +84,12 @@ TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
     for (const FieldInfo& info : kFields) {
         out.setGrid(info.field, first.grid(info.field)->deepCopyGrid());
     }
+    // A tree index grid as soon as any input knows its trees; voxels of inputs that do not
+    // stay -1 (unknown).
+    if (std::any_of(trees.begin(), trees.end(), [](const TreeGrids& t) { return bool(t.tree); })) {
+        out.tree = first.tree ? first.tree->deepCopy() : openvdb::Int32Grid::create(-1);
+        out.tree->setTransform(first.density->transform().copy());
+    }
     for (std::size_t i = 1; i < trees.size(); ++i) {
         const TreeGrids& t = trees[i];
         if (std::abs(t.voxelSize_cm - out.voxelSize_cm) > 1e-9 * out.voxelSize_cm) {
@@ -91,6 +104,7 @@ TreeGrids mergeTreeGrids(const std::vector<TreeGrids>& trees)
         // What the trees before this one occupy, fixed while the fields are filled.
         const openvdb::FloatGrid::Ptr occupied = out.density->deepCopy();
         for (const FieldInfo& info : kFields) fillInactive(info, out, t, *occupied);
+        if (t.tree) fillInactiveTyped(*out.tree, *t.tree, *occupied);
         addOverlaps(out, t, *occupied);
     }
     return out;

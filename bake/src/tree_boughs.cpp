@@ -64,9 +64,11 @@ std::string treeDigest(const std::vector<BoughSpec>& boughs)
 TreeGrids bakeScene(const std::vector<scenes::Tree>& trees, const BakeSettings& settings)
 {
     std::vector<BoughSpec> all;
-    for (const scenes::Tree& tree : trees) {
-        const std::vector<BoughSpec> boughs = treeBoughs(tree);
-        all.insert(all.end(), boughs.begin(), boughs.end());
+    for (std::size_t i = 0; i < trees.size(); ++i) {
+        for (BoughSpec& b : treeBoughs(trees[i])) {
+            b.tree = int(i);
+            all.push_back(b);
+        }
     }
     return bakeBoughs(all, settings);
 }

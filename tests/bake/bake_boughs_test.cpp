@@ -319,9 +319,13 @@ TEST(BakeBoughs, OverlappingBoughsAddTheirExtinctionWhateverTheOrder)
 TEST(BakeBoughs, TreesMergedOverlapAsTheirBoughsBakedTogetherDo)
 {
     // Two crossing boughs, each baked as a tree of its own and merged (a render's --grids), or
-    // baked together (a render's own bake): the same voxels, densities and fields.
-    const auto [thin, dense] = crossingBoughs();
+    // baked together (a render's own bake): the same voxels, densities and fields, and each
+    // voxel the tree of the denser bough there (its albedo tells which).
+    auto [thin, dense] = crossingBoughs();
     const BakeSettings settings{0.3, 1, "layer"};
+    EXPECT_FALSE(bakeBoughs({thin, dense}, settings).tree) << "no bough names its tree";
+    thin.tree = 0;
+    dense.tree = 1;
     const TreeGrids together = bakeBoughs({thin, dense}, settings);
     const TreeGrids merged =
         mergeTreeGrids({bakeBoughs({thin}, settings), bakeBoughs({dense}, settings)});
@@ -338,6 +342,22 @@ TEST(BakeBoughs, TreesMergedOverlapAsTheirBoughsBakedTogetherDo)
             << c;
         ASSERT_EQ(a.getValue(c), ta.getValue(c)) << c;
     }
+    ASSERT_TRUE(together.tree && merged.tree);
+    EXPECT_EQ(together.tree->activeVoxelCount(), together.density->activeVoxelCount());
+    const auto t = together.tree->getConstAccessor(), m = merged.tree->getConstAccessor();
+    int denseVoxels = 0, overlap = 0;
+    const TreeGrids thinAlone = bakeBoughs({thin}, settings);
+    const auto thinDensity = thinAlone.density->getConstAccessor();
+    for (auto it = together.density->cbeginValueOn(); it; ++it) {
+        const openvdb::Coord c = it.getCoord();
+        const int expected = ta.getValue(c) == openvdb::Vec3s(0.5f) ? 1 : 0;
+        ASSERT_EQ(t.getValue(c), expected) << c;
+        ASSERT_EQ(m.getValue(c), expected) << c;
+        denseVoxels += expected;
+        overlap += expected && thinDensity.isValueOn(c);
+    }
+    EXPECT_GT(overlap, 10) << "the boughs must cross for the merge's overlap to be tested";
+    EXPECT_GT(denseVoxels, overlap);
 }
 
 TEST(BakeBoughs, TheGridsDoNotDependOnTheThreads)

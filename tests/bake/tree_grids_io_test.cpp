@@ -115,6 +115,13 @@ TEST(TreeGridsIo, RoundTripKeepsValuesInEveryUnitAndFrame)
     EXPECT_EQ(r.provenance.tree, kProvenance.tree);
     EXPECT_EQ(r.provenance.seed, kProvenance.seed);
     EXPECT_EQ(r.provenance.treeDigest, kProvenance.treeDigest);
+    // Every voxel is the file's tree (in memory only: no grid of it is written).
+    ASSERT_TRUE(r.grids.tree);
+    EXPECT_EQ(r.grids.tree->activeVoxelCount(), g.density->activeVoxelCount());
+    const auto tree = r.grids.tree->getConstAccessor();
+    for (auto it = g.density->cbeginValueOn(); it; ++it) {
+        ASSERT_EQ(tree.getValue(it.getCoord()), kProvenance.tree) << it.getCoord();
+    }
     // In metres, in a tree's frame, turned: back on the scene's lattice within float rounding
     // of the values (scaled by 100 and turned, then back).
     for (const double turn : {0.0, 0.7, -2.5}) {

@@ -345,8 +345,14 @@ if [ -x "$bake" ]; then
     "$vdbtrace" render "$src/scenes/bough.json" --method reference --grids "$work/t.vdb" \
         --subpixels 1 --out "$work/r.exr" 2>"$work/err" || fail "reference from grids: $(tail -1 "$work/err")"
     [ -s "$work/r.exr" ] || fail "reference wrote no image"
-    oiiotool --info -v "$work/r.exr" | grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, specular.Y$" \
+    oiiotool --info -v "$work/r.exr" | grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, specular.Y, tree.Y$" \
         || fail "reference EXR channels: $(oiiotool --info -v "$work/r.exr" | grep 'channel list')"
+    # The file says it is tree 0 (pine:tree): the reference sums its foliage as that tree's.
+    oiiotool --info -v "$work/r.exr" | /usr/bin/python3 -c '
+import json, re, sys
+rows = json.loads(json.loads(re.search(r"pine:tree_foliage: (\".*\")", sys.stdin.read()).group(1)))
+assert len(rows) == 1 and rows[0][0] == 0 and rows[0][1] > 10 and rows[0][2] > 0, rows
+' || fail "the reference from tree 0's grids did not sum its foliage as tree 0's"
     head -c 1000 "$work/t.vdb" >"$work/cut.vdb" && cp "$work/t.vdb.json" "$work/cut.vdb.json"
     expect_error "damaged grids" 2 "manifest" -- render "$src/scenes/bough.json" --method reference \
         --grids "$work/cut.vdb" --out "$work/d.exr"

@@ -87,7 +87,7 @@ TEST(ExrOutput, OnlyTheAovsTheMethodComputes)
     };
     EXPECT_EQ(names("multiscale"), "Z diffuse foliage level tree ");
     EXPECT_EQ(names("geometry"), "Z diffuse foliage tree ");
-    EXPECT_EQ(names("reference"), "Z diffuse foliage ");
+    EXPECT_EQ(names("reference"), "Z diffuse foliage tree ");
 }
 
 TEST(ExrOutput, CameraMatricesAreForRowVectors)

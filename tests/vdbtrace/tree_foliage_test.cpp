@@ -6,6 +6,7 @@
 #include "pine/scenes/scene.h"
 #include "pine/vdbtrace/fragment.h"
 #include "pine/vdbtrace/geometry_tracer.h"
+#include "pine/vdbtrace/methods.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/traced_scene.h"
 
@@ -98,18 +99,24 @@ scenes::Scene threeFirs(int only = -1, bool overlapping = false)
     return s;
 }
 
+// Renders `s` with the method `name` (registered), explicit needles at `samples` a pixel, the
+// reference's own bake at 1 cm.
+RenderResult renderWith(const std::string& name, const scenes::Scene& s, int samples)
+{
+    const RenderMethod& method = renderMethod(name);
+    MethodSettings settings;
+    settings.geometry.samples = samples;
+    settings.voxelSize_cm = 1.0;
+    return method.render(buildTracedScene(s, method.parts), settings, {});
+}
+
 TEST(TreeFoliage, EveryMethodNamesTheTreeItsFoliageComesFrom)
 {
     // Where only tree i's own render has foliage, the whole scene's "tree" AOV must say i; a
     // pixel no tree covers says -1. Rendered with the multiscale method (every level appears
-    // on this scene) and explicit needles.
-    for (const bool geometry : {false, true}) {
-        const auto render = [&](const scenes::Scene& s) {
-            const TracedScene t = buildTracedScene(s);
-            GeometryOptions g;
-            g.samples = 1;
-            return geometry ? renderGeometry(t, g) : renderMultiscale(t);
-        };
+    // on this scene), explicit needles and the reference's voxels.
+    for (const char* name : {"multiscale", "geometry", "reference"}) {
+        const auto render = [&](const scenes::Scene& s) { return renderWith(name, s, 1); };
         const scenes::Scene all = threeFirs();
         const RenderResult whole = render(all);
         std::vector<std::vector<float>> alone;
@@ -128,7 +135,7 @@ TEST(TreeFoliage, EveryMethodNamesTheTreeItsFoliageComesFrom)
                 EXPECT_EQ(tree[p], -1.0f) << "pixel " << p;
                 ++empty;
             } else if (covering == 1 && whole.image.aovs.at("foliage")[p] > 0.0f) {
-                EXPECT_EQ(tree[p], float(only)) << "pixel " << p << (geometry ? " geometry" : "");
+                EXPECT_EQ(tree[p], float(only)) << "pixel " << p << ' ' << name;
                 ++checked;
             }
         }
@@ -189,17 +196,11 @@ TEST(TreeFoliage, ATreesSumsAreItsFragmentsWhereverItsPixelsLie)
     // own render covers are wholly its (a lower bound of its coverage) and those its own render
     // covers hold all of it (an upper bound); the trees' sums add up to the AOVs' whatever tree
     // a pixel names; and a tree of black needles has no luminance, in the pixels it shares too.
-    for (const bool geometry : {false, true}) {
-        const auto render = [&](const scenes::Scene& s) {
-            GeometryOptions g;
-            g.samples = 4;
-            const TracedScene t = buildTracedScene(s);
-            return geometry ? renderGeometry(t, g) : renderMultiscale(t);
-        };
+    for (const char* name : {"multiscale", "geometry", "reference"}) {
+        const auto render = [&](const scenes::Scene& s) { return renderWith(name, s, 4); };
         const auto sum = [](const std::vector<float>& v) {
             return std::accumulate(v.begin(), v.end(), 0.0);
         };
-        const char* name = geometry ? "geometry" : "multiscale";
         const RenderResult whole = render(threeFirs(-1, true));
         const std::vector<float>& foliage = whole.image.aovs.at("foliage");
         ASSERT_EQ(whole.treeFoliage.size(), 3u) << name;

@@ -71,12 +71,12 @@ int geometrySamples(const MethodSettings& s) { return s.geometry.samples; }
 const std::vector<RenderMethod>& renderMethods()
 {
     static const std::vector<RenderMethod> methods = {
-        {"multiscale", "closed forms, each hit at the level its footprint calls for",
-         multiscale, describeMultiscale, oneCone, true, true,
-         TracedSceneParts{.grownTrees = false}},
-        // The reference marches one set of grids merged from every tree.
+        {"multiscale", "closed forms, each hit at the level its footprint calls for", multiscale,
+         describeMultiscale, oneCone, true, true, TracedSceneParts{.grownTrees = false}},
+        // The reference marches one set of grids merged from every tree; each voxel is the tree
+        // whose needles are densest there (bake::TreeGrids::tree; -1 in files naming none).
         {"reference", "equation 7 numerically through OpenVDB grids of the boughs", reference,
-         describeReference, referenceRays, false, false, TracedSceneParts{}},
+         describeReference, referenceRays, false, true, TracedSceneParts{}},
         {"geometry", "explicit needle cylinders, point samples (the ground truth)", geometry,
          describeGeometry, geometrySamples, false, true,
          TracedSceneParts{.primitiveIndex = false, .boughLaws = false, .grownTrees = false}},

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -65,6 +66,7 @@ struct FieldReader {
     const bake::ExtinctionLaw& law;
     openvdb::Vec3SGrid::ConstAccessor gradient, needle, albedo;
     openvdb::FloatGrid::ConstAccessor opacity, coverage;
+    std::optional<openvdb::Int32Grid::ConstAccessor> trees;
     explicit FieldReader(const bake::TreeGrids& g)
         : law(bake::extinctionLaw(g.extinctionLaw)),
           gradient(g.layerGradient->getConstAccessor()),
@@ -73,7 +75,10 @@ struct FieldReader {
           opacity(g.layerOpacity->getConstAccessor()),
           coverage(g.needleCoverage->getConstAccessor())
     {
+        if (g.tree) trees = g.tree->getConstAccessor();
     }
+    /// The tree whose needles are densest in voxel ijk, -1 if unknown.
+    int tree(const openvdb::Coord& ijk) { return trees ? trees->getValue(ijk) : -1; }
     /// A line along d through voxel ijk, per cm: the law's sigma(d) and the layers crossed,
     /// d . G (signed); both 0 outside the boughs.
     struct Rates {
@@ -192,7 +197,19 @@ private:
     const double mH;
     std::unique_ptr<Intersector> mIntersector;
     std::vector<openvdb::FloatGrid::Ptr> mLightTransmittance;  // per light, per voxel centre
-    double mSpecularWeight = 0.0, mExponent = 100.0;
+    // The needles' specular lobe (not baked): per tree, the first bough's (species set it);
+    // for voxels of no known tree, the scene's first bough's.
+    struct Specular {
+        double weight = 0.0, exponent = 100.0;
+    };
+    std::vector<Specular> mSpecularOfTree;
+    Specular mSpecular;
+    const Specular& specularOf(int tree) const
+    {
+        return tree >= 0 && std::size_t(tree) < mSpecularOfTree.size()
+                   ? mSpecularOfTree[std::size_t(tree)]
+                   : mSpecular;
+    }
 };
 
 class ReferenceRayTracer final : public ShadingMethod::RayTracer, private LightTransport {
@@ -212,8 +229,9 @@ private:
     {
         return mMethod.transmittance(mThread, x, light, footprint_cm, self);
     }
-    // The needles' emission J of voxel ijk (diffuse, specular), lit through the light grids.
-    void emission(const openvdb::Coord& ijk, const Vec3& V, Vec3& jd, Vec3& js);
+    // The needles' emission J of voxel ijk of tree `tree` (diffuse, specular), lit through the
+    // light grids.
+    void emission(const openvdb::Coord& ijk, int tree, const Vec3& V, Vec3& jd, Vec3& js);
 
     const Reference& mMethod;
     Reference::Thread mThread;
@@ -231,10 +249,16 @@ Reference::Reference(const TracedScene& scene, const bake::TreeGrids& grids,
       mH(grids.voxelSize_cm)
 {
     if (mHasVolume) mIntersector = std::make_unique<Intersector>(*grids.layerOpacity);
-    for (const TracedBough& b : scene.boughs) {  // specular parameters are not baked
-        mSpecularWeight = b.specularWeight;
-        mExponent = b.exponent;
-        break;
+    if (!scene.boughs.empty()) {
+        mSpecular = {scene.boughs.front().specularWeight, scene.boughs.front().exponent};
+    }
+    mSpecularOfTree.assign(scene.treeCounts.size(), mSpecular);
+    std::vector<bool> seen(mSpecularOfTree.size(), false);
+    for (const TracedBough& b : scene.boughs) {
+        const std::size_t t = std::size_t(b.tree);
+        if (b.tree < 0 || t >= seen.size() || seen[t]) continue;
+        seen[t] = true;
+        mSpecularOfTree[t] = {b.specularWeight, b.exponent};
     }
     if (!mHasVolume || !(mPlan.shadowRays || mPlan.selfShadowing)) return;
     // The light reaching each voxel's centre depends on the voxel, not on the view: once per
@@ -261,9 +285,11 @@ std::unique_ptr<ShadingMethod::RayTracer> Reference::rayTracer(RenderStats& stat
     return std::make_unique<ReferenceRayTracer>(*this, stats);
 }
 
-void ReferenceRayTracer::emission(const openvdb::Coord& ijk, const Vec3& V, Vec3& jd, Vec3& js)
+void ReferenceRayTracer::emission(const openvdb::Coord& ijk, int tree, const Vec3& V, Vec3& jd,
+                                  Vec3& js)
 {
     const EffectsPlan& plan = mMethod.mPlan;
+    const Reference::Specular& specular = mMethod.specularOf(tree);
     const Vec3 needle = toGlm(mThread.field.needle.getValue(ijk));
     const Vec3 albedo = toGlm(mThread.field.albedo.getValue(ijk));
     const openvdb::Vec3d c = mMethod.mGrids.layerOpacity->transform().indexToWorld(ijk);
@@ -278,8 +304,7 @@ void ReferenceRayTracer::emission(const openvdb::Coord& ijk, const Vec3& V, Vec3
             ++mStats.diffuseEvaluations;
         }
         if (plan.specular) {
-            js += mMethod.mSpecularWeight * E *
-                  analytic::needleSpecular(needle, L, V, mMethod.mExponent);
+            js += specular.weight * E * analytic::needleSpecular(needle, L, V, specular.exponent);
             ++mStats.specularEvaluations;
         }
     }
@@ -312,11 +337,15 @@ void ReferenceRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
         ++mStats.voxelSpans;
         const FieldReader::Rates rates = mThread.field.rates(ijk, ray.direction);
         Vec3 jd(0.0), js(0.0);
-        if (rates.sigma > 0.0) emission(ijk, V, jd, js);
+        int tree = -1;
+        if (rates.sigma > 0.0) {
+            tree = mThread.field.tree(ijk);
+            emission(ijk, tree, V, jd, js);
+        }
         // The volume over [t0, t1] as a fragment: its opacity, and J premultiplied by it.
         const auto volume = [&](double t0, double t1) {
             const double alpha = 1.0 - line.transmittance(rates, t0, t1);
-            composite.add(Fragment{t0, alpha, alpha * jd, alpha * js, 0, true});
+            composite.add(Fragment{t0, alpha, alpha * jd, alpha * js, 0, true, tree});
         };
         while (next < surfaces.size() && surfaces[next].t <= tb) {
             const double ts = std::max(ta, surfaces[next].t);

@@ -22,6 +22,9 @@ struct BoughSpec {
     Vec3 base_cm{0.0}, tip_cm{0.0, 0.0, 1.0};
     analytic::BoughGeometry needles;
     Vec3 needleAlbedo{0.2};
+    /// The scene's tree (index of its placement) the bough belongs to, -1 if none is known:
+    /// names the voxels' tree (TreeGrids::tree), baked into no field.
+    int tree = -1;
 };
 
 /// The largest extinction per layer, -ln(1e-6): a layer whose needles cover its cone (A = 1)

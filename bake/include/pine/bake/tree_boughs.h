@@ -30,6 +30,7 @@ std::string treeDigest(const std::vector<BoughSpec>& boughs);
 
 /// The boughs of all `trees` in one set of grids, the trees' boughs in order: what the
 /// reference method renders a whole scene through (bake tree/scene write one file a tree).
+/// Each bough's tree is its index in `trees` (TreeGrids::tree).
 TreeGrids bakeScene(const std::vector<scenes::Tree>& trees, const BakeSettings& settings);
 
 }  // namespace pine::bake

@@ -92,6 +92,11 @@ struct TreeGrids {
     /// Coarser densities, lod 1, 2, ...: lod k has voxels of 2^k h, each the mean of its 8
     /// children, centred on their mean centre (its own transform, shifted by (2^k - 1) h / 2).
     std::vector<openvdb::FloatGrid::Ptr> densityPyramid;
+    /// Per voxel the scene's tree whose needles are densest there (BoughSpec::tree, or the
+    /// tree a file was baked from), background -1; null if no tree is known. Held in memory
+    /// only, never written: each file is one tree's, and a render's per-tree sums (the
+    /// reference's fragments) read it.
+    openvdb::Int32Grid::Ptr tree;
     double voxelSize_cm = 0.5;
     std::string extinctionLaw = "fibre";  ///< the law density was made with, and sigma's
 
@@ -174,7 +179,8 @@ void writeTreeGrids(const TreeGrids& grids, const std::filesystem::path& path,
                     const BakeProvenance& provenance, const FileLayout& layout = {});
 
 /// What readTreeGrids found: the grids in the scene's world space (cm), what made them, and
-/// whether a manifest vouched for the bytes.
+/// whether a manifest vouched for the bytes. grids.tree names the file's tree (pine:tree) over
+/// every voxel, where the file names one.
 struct ReadGrids {
     TreeGrids grids;
     BakeProvenance provenance;
