@@ -284,6 +284,12 @@ TEST(SceneParser, ScatterVariantsAreCopiesOfTheirFirstTree)
     expectError(j, "trees[2].scatter.variants", "must be in [1, 40] (is 41)");
     j["trees"][2]["scatter"]["variants"] = 0;
     expectError(j, "trees[2].scatter.variants", "1");
+    // A scatter turned off (count 0) keeps a variants key of 1, and only 1.
+    j["trees"][2]["scatter"]["count"] = 0;
+    j["trees"][2]["scatter"]["variants"] = 1;
+    EXPECT_EQ(parseScene(j.dump(), "off.json").trees.size(), 2u);
+    j["trees"][2]["scatter"]["variants"] = 2;
+    expectError(j, "trees[2].scatter.variants", "must be in [1, 1] (is 2)");
 }
 
 TEST(SceneParser, ScatterThatCannotKeepItsSpacingSaysSo)
