@@ -7,16 +7,31 @@
 namespace pine::bake {
 namespace {
 
+// Calls visit(ijk, value) for every active voxel of `grid`, a tile's one by one: a bake prunes
+// its grids, so a leaf of one value (a species' albedo, a bough's layer opacity, one tree) is
+// written and read as a tile.
+template <class GridT, class Visit>
+void forEachActiveVoxel(const GridT& grid, Visit&& visit)
+{
+    for (auto it = grid.cbeginValueOn(); it; ++it) {
+        if (it.isVoxelValue()) {
+            visit(it.getCoord(), *it);
+            continue;
+        }
+        const openvdb::CoordBBox box = it.getBoundingBox();
+        for (auto ijk = box.begin(); ijk; ++ijk) visit(*ijk, *it);
+    }
+}
+
 // Copies into `into` the active voxels of `from` where `occupied` has none.
 template <class GridT>
 void fillInactiveTyped(GridT& into, const GridT& from, const openvdb::FloatGrid& occupied)
 {
     auto out = into.getAccessor();
     auto taken = occupied.getConstAccessor();
-    for (auto it = from.cbeginValueOn(); it; ++it) {
-        if (!it.isVoxelValue()) continue;  // baked grids hold voxels, not tiles
-        if (!taken.isValueOn(it.getCoord())) out.setValue(it.getCoord(), *it);
-    }
+    forEachActiveVoxel(from, [&](const openvdb::Coord& c, const typename GridT::ValueType& v) {
+        if (!taken.isValueOn(c)) out.setValue(c, v);
+    });
 }
 
 void fillInactive(const FieldInfo& info, const TreeGrids& into, const TreeGrids& from,
@@ -33,8 +48,9 @@ void fillInactive(const FieldInfo& info, const TreeGrids& into, const TreeGrids&
 
 /// Where `from` and the trees before it (`occupied`) both hold a voxel, their needles are all
 /// there, as where one tree's boughs overlap (bakeBoughs): the densities add, and the layered
-/// fields are the denser tree's there, its layer gradient scaled by the sum over its own, and
-/// the voxel is the denser tree's (TreeGrids::tree).
+/// fields are the denser's there (this tree's or the sum of those before it), its layer
+/// gradient scaled by the sum over its own, and the voxel names the tree whose fields it keeps
+/// (TreeGrids::tree).
 void addOverlaps(const TreeGrids& into, const TreeGrids& from, const openvdb::FloatGrid& occupied)
 {
     auto density = into.density->getAccessor();
@@ -53,11 +69,9 @@ void addOverlaps(const TreeGrids& into, const TreeGrids& from, const openvdb::Fl
     std::optional<openvdb::Int32Grid::ConstAccessor> theirTree;
     if (into.tree) tree = into.tree->getAccessor();
     if (from.tree) theirTree = from.tree->getConstAccessor();
-    for (auto it = from.density->cbeginValueOn(); it; ++it) {
-        if (!it.isVoxelValue()) continue;
-        const openvdb::Coord c = it.getCoord();
-        if (!taken.isValueOn(c)) continue;
-        const float mine = density.getValue(c), theirs = *it, sum = mine + theirs;
+    forEachActiveVoxel(*from.density, [&](const openvdb::Coord& c, float theirs) {
+        if (!taken.isValueOn(c)) return;
+        const float mine = density.getValue(c), sum = mine + theirs;
         if (theirs > mine) {
             gradient.setValue(c, theirGradient.getValue(c));
             opacity.setValue(c, theirOpacity.getValue(c));
@@ -69,7 +83,7 @@ void addOverlaps(const TreeGrids& into, const TreeGrids& from, const openvdb::Fl
         const float kept = std::max(mine, theirs);
         if (kept > 0.0f) gradient.setValue(c, gradient.getValue(c) * (sum / kept));
         density.setValue(c, sum);
-    }
+    });
 }
 
 }  // namespace

@@ -51,6 +51,8 @@ constexpr double kBytesPerNeedle = 140.0;
 // (23,375 and 102,785 leaves), about 30 KB a leaf beside the rest; counting voxels as if
 // they filled their leaves had estimated 426 MiB and 1.9 GiB.
 constexpr double kBytesPerVoxel = 60.0, kBytesPerVoxelLight = 8.0;
+// A render's bake also names each voxel's tree (TreeGrids::tree, an int).
+constexpr double kBytesPerVoxelTree = 4.0;
 // A bake written in metres or in a tree's frame converts a copy of every grid while writing:
 // the grids' 48 bytes a voxel and the density levels, 60 in all. Measured (bake, 2 cores):
 // the paper forest at 0.25 cm peaked at 741 MiB, estimated 859; one fir at 0.125 cm 1.6 GiB,
@@ -318,11 +320,13 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
                            own.needles * kBytesPerNeedle});
     } else if (method == "reference") {
         if (voxelsRead > 0.0) {
-            e.parts.push_back({"light grids", voxelsRead * kBytesPerVoxelLight * lights});
+            e.parts.push_back({"light grids and the voxels' trees",
+                               voxelsRead * (kBytesPerVoxelLight * lights + kBytesPerVoxelTree)});
         } else {
             const std::vector<std::size_t> all = allTrees(scene);
             const std::map<std::string, SpeciesSample> bySpecies = samples(scene, all);
-            addVoxels(e, sampledTrees(bySpecies, scene, all), voxelSize_cm, lights);
+            addVoxels(e, sampledTrees(bySpecies, scene, all), voxelSize_cm, lights,
+                      kBytesPerVoxel + kBytesPerVoxelTree);
         }
     }
     return e;

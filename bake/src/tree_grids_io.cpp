@@ -421,11 +421,10 @@ ReadGrids parseTreeGrids(const std::string& bytes, const fs::path& path, bool ve
     if (const auto m = meta->getMetadata<openvdb::StringMetadata>("pine:tree_digest")) {
         p.treeDigest = m->value();
     }
-    if (p.tree >= 0) {  // every voxel is that tree's
-        out.tree = openvdb::Int32Grid::create(-1);
+    if (p.tree >= 0) {  // every voxel is that tree's, tiles staying tiles
+        out.tree = openvdb::Int32Grid::create(std::make_shared<openvdb::Int32Tree>(
+            out.density->tree(), -1, p.tree, openvdb::TopologyCopy()));
         out.tree->setTransform(out.density->transform().copy());
-        out.tree->tree().topologyUnion(out.density->tree());
-        for (auto it = out.tree->beginValueOn(); it; ++it) it.setValue(p.tree);
     }
     return read;
 }

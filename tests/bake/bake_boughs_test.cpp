@@ -360,6 +360,83 @@ TEST(BakeBoughs, TreesMergedOverlapAsTheirBoughsBakedTogetherDo)
     EXPECT_GT(denseVoxels, overlap);
 }
 
+// Grids of one tree `tree` holding a tile: the leaf of voxels [origin, origin + 7]^3 filled
+// with one value per field (as a bake's prune leaves a constant leaf, and a file keeps it).
+TreeGrids oneTile(const TreeGrids& like, const openvdb::Coord& origin, float density, int tree)
+{
+    TreeGrids out;
+    out.voxelSize_cm = like.voxelSize_cm;
+    out.extinctionLaw = like.extinctionLaw;
+    const openvdb::CoordBBox leaf(origin, origin.offsetBy(7));
+    for (const FieldInfo& info : kFields) {
+        const openvdb::GridBase::Ptr grid = like.grid(info.field)->copyGridWithNewTree();
+        if (info.vector) {
+            const openvdb::Vec3s v(info.field == Field::NeedleAlbedo ? 0.7f : 0.0f, 0.0f, density);
+            static_cast<openvdb::Vec3SGrid&>(*grid).fill(leaf, v, true);
+        } else {
+            static_cast<openvdb::FloatGrid&>(*grid).fill(leaf, density, true);
+        }
+        out.setGrid(info.field, grid);
+    }
+    out.tree = openvdb::Int32Grid::create(-1);
+    out.tree->setTransform(like.density->transform().copy());
+    out.tree->fill(leaf, tree, true);
+    return out;
+}
+
+TEST(BakeBoughs, AMergedVoxelNamesTheTreeWhoseFieldsItKeeps)
+{
+    // The denser tree's, whichever is merged first; voxels of grids that name no tree -1; a
+    // tile (a leaf of one value, as a bake's prune makes) merged voxel by voxel, where the
+    // trees before it hold nothing and where they do.
+    auto [thin, dense] = crossingBoughs();
+    const BakeSettings settings{0.3, 1, "layer"};
+    thin.tree = 0;
+    dense.tree = 1;
+    const TreeGrids t0 = bakeBoughs({thin}, settings), t1 = bakeBoughs({dense}, settings);
+    const TreeGrids ab = mergeTreeGrids({t0, t1}), ba = mergeTreeGrids({t1, t0});
+    ASSERT_EQ(ab.tree->activeVoxelCount(), ab.density->activeVoxelCount());
+    const auto a = ab.tree->getConstAccessor(), b = ba.tree->getConstAccessor();
+    const auto d1 = t1.density->getConstAccessor();
+    int ones = 0;
+    for (auto it = ab.density->cbeginValueOn(); it; ++it) {
+        const openvdb::Coord c = it.getCoord();
+        ASSERT_EQ(a.getValue(c), b.getValue(c)) << c;
+        ASSERT_EQ(a.getValue(c), d1.isValueOn(c) ? 1 : 0) << c;
+        ones += a.getValue(c);
+    }
+    EXPECT_GT(ones, 0);
+
+    thin.tree = -1;  // a tree of no known index, merged first or last
+    const TreeGrids unnamed = bakeBoughs({thin}, settings);
+    for (const TreeGrids& m : {mergeTreeGrids({unnamed, t1}), mergeTreeGrids({t1, unnamed})}) {
+        ASSERT_TRUE(m.tree);
+        const auto t = m.tree->getConstAccessor();
+        for (auto it = m.density->cbeginValueOn(); it; ++it) {
+            ASSERT_EQ(t.getValue(it.getCoord()), d1.isValueOn(it.getCoord()) ? 1 : -1);
+        }
+    }
+
+    // Tiles: one far from tree 0's voxels, one over a leaf it holds voxels in.
+    const openvdb::Coord far(800, 800, 800);
+    openvdb::Coord near = t0.density->cbeginValueOn().getCoord();
+    near = openvdb::Coord(near.x() & ~7, near.y() & ~7, near.z() & ~7);
+    for (const openvdb::Coord& origin : {far, near}) {
+        const TreeGrids tile = oneTile(t0, origin, 50.0f, 2);
+        ASSERT_GT(tile.needleAlbedo->tree().activeTileCount(), 0u) << "fill made no tile";
+        const TreeGrids m = mergeTreeGrids({t0, tile});
+        const auto density = m.density->getConstAccessor();
+        const auto albedo = m.needleAlbedo->getConstAccessor();
+        const auto tree = m.tree->getConstAccessor();
+        const auto before = t0.density->getConstAccessor();
+        for (auto ijk = openvdb::CoordBBox(origin, origin.offsetBy(7)).begin(); ijk; ++ijk) {
+            ASSERT_EQ(density.getValue(*ijk), 50.0f + before.getValue(*ijk)) << *ijk;
+            ASSERT_EQ(albedo.getValue(*ijk).x(), 0.7f) << *ijk;
+            ASSERT_EQ(tree.getValue(*ijk), 2) << *ijk;
+        }
+    }
+}
+
 TEST(BakeBoughs, TheGridsDoNotDependOnTheThreads)
 {
     // Boughs crossing in a star, several in most voxels: their sums are added in an order set

@@ -122,6 +122,11 @@ TEST(TreeGridsIo, RoundTripKeepsValuesInEveryUnitAndFrame)
     for (auto it = g.density->cbeginValueOn(); it; ++it) {
         ASSERT_EQ(tree.getValue(it.getCoord()), kProvenance.tree) << it.getCoord();
     }
+    BakeProvenance noTree = kProvenance;
+    noTree.tree = -1;
+    const test::TempDir other;
+    writeTreeGrids(g, other.path() / "no-tree.vdb", noTree);
+    EXPECT_FALSE(readTreeGrids(other.path() / "no-tree.vdb").grids.tree);
     // In metres, in a tree's frame, turned: back on the scene's lattice within float rounding
     // of the values (scaled by 100 and turned, then back).
     for (const double turn : {0.0, 0.7, -2.5}) {

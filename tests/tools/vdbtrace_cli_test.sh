@@ -347,12 +347,17 @@ if [ -x "$bake" ]; then
     [ -s "$work/r.exr" ] || fail "reference wrote no image"
     oiiotool --info -v "$work/r.exr" | grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, specular.Y, tree.Y$" \
         || fail "reference EXR channels: $(oiiotool --info -v "$work/r.exr" | grep 'channel list')"
-    # The file says it is tree 0 (pine:tree): the reference sums its foliage as that tree's.
-    oiiotool --info -v "$work/r.exr" | /usr/bin/python3 -c '
+    # A file says which tree it is (pine:tree): the reference sums its foliage as that tree's.
+    "$bake" tree "$src/scenes/three-firs.json" --tree 1 --voxel-size 1 --out "$work/t1.vdb" \
+        2>/dev/null || fail "bake tree --tree 1 failed"
+    "$vdbtrace" render "$src/scenes/three-firs.json" --method reference --grids "$work/t1.vdb" \
+        --subpixels 1 --resolution 80x60 --out "$work/r1.exr" 2>/dev/null \
+        || fail "reference from tree 1's grids failed"
+    oiiotool --info -v "$work/r1.exr" | /usr/bin/python3 -c '
 import json, re, sys
 rows = json.loads(json.loads(re.search(r"pine:tree_foliage: (\".*\")", sys.stdin.read()).group(1)))
-assert len(rows) == 1 and rows[0][0] == 0 and rows[0][1] > 10 and rows[0][2] > 0, rows
-' || fail "the reference from tree 0's grids did not sum its foliage as tree 0's"
+assert len(rows) == 1 and rows[0][0] == 1 and rows[0][1] > 10 and rows[0][2] > 0, rows
+' || fail "the reference from tree 1's grids did not sum its foliage as tree 1's"
     head -c 1000 "$work/t.vdb" >"$work/cut.vdb" && cp "$work/t.vdb.json" "$work/cut.vdb.json"
     expect_error "damaged grids" 2 "manifest" -- render "$src/scenes/bough.json" --method reference \
         --grids "$work/cut.vdb" --out "$work/d.exr"

@@ -74,7 +74,7 @@ const std::vector<RenderMethod>& renderMethods()
         {"multiscale", "closed forms, each hit at the level its footprint calls for", multiscale,
          describeMultiscale, oneCone, true, true, TracedSceneParts{.grownTrees = false}},
         // The reference marches one set of grids merged from every tree; each voxel is the tree
-        // whose needles are densest there (bake::TreeGrids::tree; -1 in files naming none).
+        // whose fields it keeps (bake::TreeGrids::tree; -1 in files naming none).
         {"reference", "equation 7 numerically through OpenVDB grids of the boughs", reference,
          describeReference, referenceRays, false, true, TracedSceneParts{}},
         {"geometry", "explicit needle cylinders, point samples (the ground truth)", geometry,

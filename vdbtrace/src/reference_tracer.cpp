@@ -77,7 +77,7 @@ struct FieldReader {
     {
         if (g.tree) trees = g.tree->getConstAccessor();
     }
-    /// The tree whose needles are densest in voxel ijk, -1 if unknown.
+    /// The tree whose layered fields voxel ijk keeps (bake::TreeGrids::tree), -1 if unknown.
     int tree(const openvdb::Coord& ijk) { return trees ? trees->getValue(ijk) : -1; }
     /// A line along d through voxel ijk, per cm: the law's sigma(d) and the layers crossed,
     /// d . G (signed); both 0 outside the boughs.

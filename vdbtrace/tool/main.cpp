@@ -484,6 +484,8 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         std::vector<bake::TreeGrids> trees;
         for (const fs::path& file : gridFiles) {
             bake::ReadGrids read = bake::readTreeGrids(file, memoryLimit);
+            // Only a tree checkBakedFrom can check (by its digest) names the file's voxels.
+            if (read.provenance.treeDigest.empty()) read.grids.tree.reset();
             if (!read.unverified.empty()) {
                 std::cerr << "vdbtrace: warning: '" << file.string() << "': " << read.unverified
                           << '\n';

@@ -92,10 +92,12 @@ struct TreeGrids {
     /// Coarser densities, lod 1, 2, ...: lod k has voxels of 2^k h, each the mean of its 8
     /// children, centred on their mean centre (its own transform, shifted by (2^k - 1) h / 2).
     std::vector<openvdb::FloatGrid::Ptr> densityPyramid;
-    /// Per voxel the scene's tree whose needles are densest there (BoughSpec::tree, or the
-    /// tree a file was baked from), background -1; null if no tree is known. Held in memory
-    /// only, never written: each file is one tree's, and a render's per-tree sums (the
-    /// reference's fragments) read it.
+    /// Per voxel the scene's tree whose layered fields the voxel keeps: its densest bough's
+    /// (BoughSpec::tree; -1 for a bough naming none), or where mergeTreeGrids meets trees the
+    /// denser of the next tree and those before it summed; background -1, null if no bough or
+    /// file names a tree. A voxel's whole extinction counts for that tree, so where crowns
+    /// share voxels a per-tree sum gives the neighbour's share to it. Held in memory only,
+    /// never written: each file is one tree's and says which (pine:tree).
     openvdb::Int32Grid::Ptr tree;
     double voxelSize_cm = 0.5;
     std::string extinctionLaw = "fibre";  ///< the law density was made with, and sigma's
@@ -120,7 +122,7 @@ int boxPointsPerEdge(double boughRadius_cm, double voxelSize_cm);
 /// Voxelizes the boughs (not the branches: the tracers draw those as cylinders). Each voxel
 /// holds a bough's extinction at its centre, or over its box (boxPointsPerEdge: the extinction
 /// whose opacity over its mean chord 2h/3 is its points' mean opacity), and where boughs overlap
-/// their sum (bake/README.md). Boughs are
+/// their sum (bake/README.md); `tree` where any bough names its tree. Boughs are
 /// split among TBB threads; the result does not depend on the split (ties keep the bough listed
 /// first). Throws BakeError for a voxel size checkVoxelSize refuses, pyramid levels
 /// outside [1, 16], or a bough outside its domain (non-finite, phi outside (0, pi/2], a

@@ -32,6 +32,8 @@ inline bake::BakeSettings referenceBake(double voxelSize_cm)
 /// Renders `scene` (branches and ground as in the multiscale method, boughs through `grids`).
 /// Light is attenuated through the grids when the scene asks for shadows or self-shadowing
 /// (the grids hold every bough: the two are not told apart), and by branches with shadows.
+/// Each voxel's needles reflect with its tree's specular lobe (bake::TreeGrids::tree; the
+/// scene's first bough's where no tree is known) and sum into its tree's foliage.
 RenderResult renderReference(const TracedScene& scene, const bake::TreeGrids& grids,
                              const ReferenceOptions& method = {},
                              const RenderOptions& options = {});

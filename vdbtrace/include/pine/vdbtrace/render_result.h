@@ -40,7 +40,7 @@ struct RenderResult {
     double seconds = 0.0;      ///< wall clock, including what the method prepares first
     double prepSeconds = 0.0;  ///< of `seconds`, that preparation (BVH, bake, light grids)
     /// Each tree's foliage, fragment by fragment (tree_foliage_tally.h); empty where the
-    /// method knows no trees (the reference's merged grids).
+    /// method knows no trees (a reference through files that name none).
     std::vector<TreeFoliageSum> treeFoliage;
 };
 
