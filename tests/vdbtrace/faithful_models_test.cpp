@@ -310,6 +310,64 @@ double reference(double angle_deg, const std::string& law)
     return totalOpacity(renderReference(s.traced, grids, options));
 }
 
+// The reference's light on the long bough side-on (fibre law, 0.25 cm, 2 x 2 rays), with
+// `effects` under the light towards `towards`.
+double referenceLight(const std::string& effects, const char* towards)
+{
+    const LongBough s(90.0, {}, 7, effects, towards);
+    bake::BoughSpec spec;
+    const TracedBough& b = s.traced.boughs.front();
+    spec.base_cm = b.base_cm;
+    spec.tip_cm = b.tip_cm;
+    spec.needles = b.geometry;
+    const bake::TreeGrids grids = bake::bakeBoughs({spec}, referenceBake(0.25));
+    ReferenceOptions options;
+    options.subpixels = 2;
+    return totalLight(renderReference(s.traced, grids, options));
+}
+
+TEST(FaithfulModels, TheReferencesNeedlesAreLitAsTheNeedlesAre)
+{
+    // The long bough side-on under four lights, the reference's light against the needles'
+    // (their mean over 4 rolls), in diffuse light alone (within 5%, as levels 2-3 along the
+    // branch) and through the bough itself. A needle lies on its cone's layer, so the light
+    // reaching it crosses the layers between it and the bough's edge, not the part of a layer
+    // that the line from a point between layers would also cross: read from such points, the
+    // reference's self-shadowed needles got 0.888, 0.743, 0.816 and 0.702 of the needles'
+    // light, now 0.980, 0.814, 0.885 and 0.790 (docs/models.md, "The reference's light").
+    // The layer models get 0.89-1.05 here (ALoneBoughUnderEveryLight): the bound below holds
+    // the gain, the 3% of issue 9 is not met under the three lights from aside and behind.
+    const char* lights[] = {"[0.3, -1, 0.6]", "[1, 0, 0.3]", "[0, 0, 1]", "[0.3, 1, 0.6]"};
+    const std::string diffuse = R"("diffuse")";
+    const std::string selfShadowed = R"("diffuse", "self_shadowing", "shadows")";
+    for (const char* towards : lights) {
+        constexpr int kRolls = 4;
+        double lit = 0.0, shadowed = 0.0;
+        for (unsigned seed = 1; seed <= kRolls; ++seed) {
+            GeometryOptions g;
+            g.samples = 16;
+            const auto needles = [&](const std::string& effects) {
+                return totalLight(
+                    renderGeometry(LongBough(90.0, {}, seed, effects, towards).traced, g));
+            };
+            lit += needles(diffuse) / kRolls;
+            shadowed += needles(selfShadowed) / kRolls;
+        }
+        const double d = referenceLight(diffuse, towards) / lit;
+        const double s = referenceLight(selfShadowed, towards) / shadowed;
+        std::printf(
+            "reference lit towards %s, against the needles: diffuse alone %.3f, "
+            "self-shadowed %.3f (the needles let %.3f through)\n",
+            towards, d, s, shadowed / lit);
+        EXPECT_NEAR(d, 1.0, 0.05) << towards;
+        EXPECT_GT(s, 0.77) << towards;
+        EXPECT_LT(s, 1.05) << towards;
+        if (towards == lights[0]) {
+            EXPECT_NEAR(s, 1.0, 0.05) << "the camera's side, above";
+        }
+    }
+}
+
 TEST(FaithfulModels, TheReferenceFieldsAgainstTheNeedles)
 {
     // The reference at 0.25 cm on the long bough side-on and at 60 and 30 degrees. The fibre

@@ -58,6 +58,9 @@ public:
         return T;
     }
 
+    /// What the band begun last, and not yet crossed whole, lets through so far (1 if none).
+    double openBand() const { return mCrossed < 1.0 ? 1.0 - std::min(1.0, mNeedles) : 1.0; }
+
 private:
     void begin()
     {
