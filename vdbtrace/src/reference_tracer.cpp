@@ -101,13 +101,26 @@ struct FieldReader {
 
 // One line's spans through the field, in order: the transmittance of each, exp(-sigma dt) for
 // an extinction law, the bands of evenly spaced needles for a banded one (layer_bands.h).
+//
+// A line from a needle's point (towards a light) starts on one of its bough's layers, where
+// the bands, drawn from where a line starts, assume no phase: each band's needles are spread
+// along it. From a layer, the layers lie at the bands' ends, so the band in which the line
+// leaves the point's bough holds no layer, though it stopped 1 - openBand() of the light
+// (half a layer's opacity on average: the reference's needles read 16-19% dark under
+// self-shadowing on three firs, docs/models.md). attenuated() divides that band out where the
+// line leaves the bough: at a gap in the medium or a voxel of none. Boughs met farther on are
+// met at any phase.
 class LineThroughField {
 public:
     explicit LineThroughField(const bake::ExtinctionLaw& law) : mBanded(law.banded()) {}
+    /// A line from a needle's point, on a layer: `gap_cm` is how far apart two spans may be
+    /// and still be one stretch of the point's bough.
+    LineThroughField(const bake::ExtinctionLaw& law, double gap_cm)
+        : mBanded(law.banded()), mOnOwnBough(true), mGap_cm(gap_cm)
+    {
+    }
 
-    /// What the band begun last lets through so far, 1 for an unbanded law.
-    double openBand() const { return mBanded ? mBands.openBand() : 1.0; }
-
+    /// The span's own transmittance.
     double transmittance(const FieldReader::Rates& r, double ta, double tb)
     {
         if (!mBanded) return std::exp(-r.sigma * (tb - ta));
@@ -117,10 +130,29 @@ public:
         return mBands.span(r.sigma * (tb - ta), r.layers * (tb - ta));
     }
 
+    /// T, the line's transmittance up to the span, carried across it.
+    double attenuated(double T, const FieldReader::Rates& r, double ta, double tb)
+    {
+        if (mOnOwnBough && (ta > mOwnEnd + mGap_cm || !(r.sigma > 0.0))) T = leaveOwnBough(T);
+        if (mOnOwnBough) mOwnEnd = tb;
+        return T * transmittance(r, ta, tb);
+    }
+    /// T at the line's end (the point's bough may reach that far).
+    double finished(double T) { return mOnOwnBough && T > 0.0 ? leaveOwnBough(T) : T; }
+
 private:
+    double leaveOwnBough(double T)
+    {
+        mOnOwnBough = false;
+        const double open = mBanded ? mBands.openBand() : 1.0;
+        return open > 0.0 ? T / open : T;
+    }
+
     bool mBanded;
     LayerBands mBands;
     double mEnd = -std::numeric_limits<double>::infinity();
+    bool mOnOwnBough = false;
+    double mGap_cm = 0.0, mOwnEnd = 0.0;
 };
 
 class ReferenceRayTracer;
@@ -183,27 +215,12 @@ public:
         mScene.lights[light].at(x, L, distance, irradiance);
         const double tMax = std::isfinite(distance) ? distance : 1e7;
         double T = 1.0;
-        LineThroughField line(thread.field.law);
-        // The bands of evenly spaced needles start at x, their needles spread over each band
-        // (where a band's layer lies is unknown). From a needle on a layer, the layers lie at
-        // the bands' ends: where the line leaves x's bough part way into a band, that band
-        // holds no layer, though it stopped 1 - openBand() of the light (half a layer's
-        // opacity on average: the reference's needles read 16-19% dark under self-shadowing
-        // on three firs, docs/models.md). Boughs met farther on are met at any phase.
-        bool own = onLayer;
-        double ownEnd = 0.0;
-        const auto leaveOwn = [&] {
-            own = false;
-            if (const double open = line.openBand(); open > 0.0) T /= open;
-        };
+        LineThroughField line = onLayer ? LineThroughField(thread.field.law, 1e-6 * mH)
+                                        : LineThroughField(thread.field.law);
         march(thread, x, L, tMax, [&](const openvdb::Coord& ijk, double ta, double tb) {
-            if (!(T > 0.0)) return;
-            const FieldReader::Rates rates = thread.field.rates(ijk, L);
-            if (own && (ta > ownEnd + 1e-6 * mH || !(rates.sigma > 0.0))) leaveOwn();
-            if (own) ownEnd = tb;
-            T *= line.transmittance(rates, ta, tb);
+            if (T > 0.0) T = line.attenuated(T, thread.field.rates(ijk, L), ta, tb);
         });
-        if (own && T > 0.0) leaveOwn();
+        T = line.finished(T);
         if (mPlan.shadowRays) {
             T *= shadowConeTransmittance(mScene, x, light, footprint_cm, self, false);
         }
