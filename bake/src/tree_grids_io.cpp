@@ -447,8 +447,8 @@ ReadGrids readTreeGrids(const fs::path& path, double maxMemoryBytes)
     // gigabytes, or loop for minutes, on a file of kilobytes.
     const double size = double(bytes.size());
     const double limit = maxMemoryBytes > 0.0 ? maxMemoryBytes : defaultMemoryLimit();
-    const io::IsolationLimits limits{std::min(limit, 1024.0 * 1024 * 1024 + 256.0 * size),
-                                     std::round(10.0 + size / 2e6)};
+    const double soundFileCap = 1024.0 * 1024 * 1024 + 256.0 * size;
+    const io::IsolationLimits limits{std::min(limit, soundFileCap), std::round(10.0 + size / 2e6)};
     io::IsolatedOutcome trial;
     try {
         trial = io::runIsolated([&] { (void)parseTreeGrids(bytes, path, verified); }, limits);
@@ -457,8 +457,17 @@ ReadGrids readTreeGrids(const fs::path& path, double maxMemoryBytes)
     }
     if (trial.kind == io::IsolatedOutcome::Kind::Threw) throw BakeError(trial.why);
     if (!trial.returned()) {
-        throw BakeError("cannot read '" + path.string() + "': OpenVDB " + trial.why +
-                        " on it (damaged?)");
+        // Under the caller's limit, a sound file may fail as a damaged one does (OpenVDB
+        // aborts or crashes where an allocation fails): say which limit it was.
+        const bool outOfMemory = trial.kind == io::IsolatedOutcome::Kind::OutOfMemory;
+        const std::string cause =
+            limit < soundFileCap
+                ? (outOfMemory ? "" : " within the memory limit of " + formatBytes(limit)) +
+                      " (the limit too low for a file of " + formatBytes(size) +
+                      ", or the file damaged)"
+                : " (damaged?)";
+        throw BakeError("cannot read '" + path.string() + "': OpenVDB " + trial.why + " on it" +
+                        cause);
     }
     ReadGrids read = parseTreeGrids(bytes, path, verified);
     if (!verified) {
