@@ -51,6 +51,8 @@ constexpr double kBytesPerNeedle = 140.0;
 // (23,375 and 102,785 leaves), about 30 KB a leaf beside the rest; counting voxels as if
 // they filled their leaves had estimated 426 MiB and 1.9 GiB.
 constexpr double kBytesPerVoxel = 60.0, kBytesPerVoxelLight = 8.0;
+// Of them, the grids a bake's file holds: what `render --grids` reads.
+constexpr double kBytesPerVoxelGrids = 48.0;
 // A render's bake also names each voxel's tree (TreeGrids::tree, an int).
 constexpr double kBytesPerVoxelTree = 4.0;
 // A bake written in metres or in a tree's frame converts a copy of every grid while writing:
@@ -320,8 +322,11 @@ ResourceEstimate estimateRender(const scenes::Scene& scene, const std::string& m
                            own.needles * kBytesPerNeedle});
     } else if (method == "reference") {
         if (voxelsRead > 0.0) {
-            e.parts.push_back({"light grids and the voxels' trees",
-                               voxelsRead * (kBytesPerVoxelLight * lights + kBytesPerVoxelTree)});
+            // Read and merged before the render, held to its end (the per-file copies are let
+            // go once merged, so the merged grids stand for them).
+            e.parts.push_back({"the baked grids read (" + formatCount(voxelsRead) + " voxels)",
+                               voxelsRead * (kBytesPerVoxelGrids + kBytesPerVoxelTree)});
+            e.parts.push_back({"light grids", voxelsRead * kBytesPerVoxelLight * lights});
         } else {
             const std::vector<std::size_t> all = allTrees(scene);
             const std::map<std::string, SpeciesSample> bySpecies = samples(scene, all);

@@ -45,6 +45,15 @@ void TreeGrids::setGrid(Field field, const openvdb::GridBase::Ptr& grid)
     }
 }
 
+double allocatedVoxels(const TreeGrids& g)
+{
+    if (!g.layerOpacity) return 0.0;
+    const openvdb::FloatTree& tree = g.layerOpacity->tree();
+    using Leaf = openvdb::FloatTree::LeafNodeType;
+    return double(tree.leafCount()) * double(Leaf::SIZE) +
+           double(tree.activeVoxelCount() - tree.activeLeafVoxelCount());
+}
+
 const char* unitName(LengthUnit unit) { return unit == LengthUnit::Metre ? "m" : "cm"; }
 
 LengthUnit lengthUnit(const std::string& name)

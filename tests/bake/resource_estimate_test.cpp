@@ -70,6 +70,47 @@ TEST(ResourceEstimate, VoxelsAreCountedInTheLeavesThatHoldThem)
     }
 }
 
+TEST(ResourceEstimate, GridsReadAreCountedWithTheirLight)
+{
+    // render --grids: the grids read are held to the render's end beside each light's grid.
+    // The estimate had counted the light grids alone (as if the grids read cost nothing), by
+    // active voxels where OpenVDB allocates a leaf's 8^3 whole.
+    const scenes::Scene scene =
+        scenes::loadScene(std::string(PINE_SOURCE_DIR) + "/scenes/three-firs.json");
+    const scenes::Tree tree =
+        scenes::growTree(scene.species.at(scene.trees[0].species), scene.trees[0]);
+    std::vector<BoughSpec> boughs = treeBoughs(tree);
+    for (BoughSpec& b : boughs) b.tree = 0;  // as a scene's bake names them
+    const TreeGrids grids = bakeBoughs(boughs, BakeSettings{0.5, 1, "fibre"});
+    ASSERT_TRUE(grids.tree);
+    // What grows with the forest is the leaves; the internal nodes above them, a few hundred
+    // KB a grid for one fir, are what the estimate's factor of 1.5 leaves room for.
+    double leaves = 0.0, held = 0.0;
+    const auto add = [&](const auto& grid) {
+        held += double(grid.memUsage());
+        for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) leaves += double(leaf->memUsage());
+    };
+    add(*grids.density);
+    add(*grids.layerGradient);
+    add(*grids.layerOpacity);
+    add(*grids.needleDirection);
+    add(*grids.needleCoverage);
+    add(*grids.needleAlbedo);
+    add(*grids.tree);
+    const double voxels = allocatedVoxels(grids);
+    EXPECT_GE(voxels, double(grids.layerOpacity->activeVoxelCount()));
+    double read = -1.0, light = -1.0;
+    for (const ResourceEstimate::Part& p : estimateRender(scene, "reference", 0.5, voxels).parts) {
+        if (p.what.find("baked grids read") != std::string::npos) read = p.bytes;
+        if (p.what == "light grids") light = p.bytes;
+    }
+    EXPECT_GE(read / leaves, 0.95) << read << " estimated, leaves " << leaves;
+    EXPECT_LE(read / held, 1.5) << read << " estimated, " << held << " held";
+    EXPECT_GE(read * 1.5, held) << read << " estimated, " << held << " held";
+    const double lights = double(scene.pointLights.size() + scene.directionalLights.size());
+    EXPECT_NEAR(light, voxels * 8.0 * lights, 1.0);  // a float a voxel and light, with its leaf
+}
+
 TEST(ResourceEstimate, ALawCacheBoundsTheMultiscaleProfiles)
 {
     // Every bough's profiles at most; a --law-cache budget below that replaces them, and one

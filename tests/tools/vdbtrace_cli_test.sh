@@ -358,6 +358,17 @@ import json, re, sys
 rows = json.loads(json.loads(re.search(r"pine:tree_foliage: (\".*\")", sys.stdin.read()).group(1)))
 assert len(rows) == 1 and rows[0][0] == 1 and rows[0][1] > 10 and rows[0][2] > 0, rows
 ' || fail "the reference from tree 1's grids did not sum its foliage as tree 1's"
+    # The grids read count in the memory estimate (they had not: only their light grids, by
+    # active voxels); a limit too low to read a sound file says so, not only "damaged?".
+    "$bake" tree "$src/scenes/three-firs.json" --tree 1 --voxel-size 0.25 --out "$work/t25.vdb" \
+        2>/dev/null || fail "bake tree at 0.25 cm failed"
+    expect_error "grids read beyond --max-memory" 2 "the baked grids read (" -- render \
+        "$src/scenes/three-firs.json" --method reference --grids "$work/t25.vdb" \
+        --resolution 80x60 --max-memory 0.3 --out "$work/m.exr"
+    expect_error "a limit too low to read grids" 2 "(the limit too low for a file of" -- render \
+        "$src/scenes/three-firs.json" --method reference --grids "$work/t25.vdb" \
+        --resolution 80x60 --max-memory 0.01 --out "$work/m.exr"
+    [ ! -e "$work/m.exr" ] || fail "a refused render wrote its image"
     head -c 1000 "$work/t.vdb" >"$work/cut.vdb" && cp "$work/t.vdb.json" "$work/cut.vdb.json"
     expect_error "damaged grids" 2 "manifest" -- render "$src/scenes/bough.json" --method reference \
         --grids "$work/cut.vdb" --out "$work/d.exr"

@@ -509,8 +509,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                                  " reaches outside the " + std::to_string(scene.camera.width) +
                                  " x " + std::to_string(scene.camera.height) + " frame");
             }
-            const double voxelsRead =
-                baked ? double(baked->layerOpacity->activeVoxelCount()) : 0.0;
+            const double voxelsRead = baked ? bake::allocatedVoxels(*baked) : 0.0;
             const auto estimate = [&](double lawProfiles_bytes) {
                 return bake::estimateRender(
                     scene, methodName, settings.voxelSize_cm, voxelsRead,

@@ -41,8 +41,9 @@ TreeTotals estimateTrees(const scenes::Scene& scene, const std::vector<std::size
 /// law profiles of every bough, or `lawProfileBudget_bytes` if less; the grown trees and the
 /// explicit needles; the reference's voxels of `voxelSize_cm` with the light reaching each,
 /// counted in the OpenVDB leaves that hold them (8^3 voxels allocated whole), or
-/// with `voxelsRead` > 0, grids already read, only that light). Each species is grown once,
-/// for its first placement, which stands for all of its placements.
+/// with `voxelsRead` > 0, the voxels of the grids read (allocatedVoxels), held with the light
+/// reaching each). Each species is grown once, for its first placement, which stands for all of
+/// its placements.
 /// With `instanceVariants` (the geometry method with Embree's curves), the needles of a
 /// scatter's variant count once, whatever the trees that copy it (TreePlacement::variantOf).
 ResourceEstimate estimateRender(

@@ -108,6 +108,11 @@ struct TreeGrids {
     void setGrid(Field field, const openvdb::GridBase::Ptr& grid);
 };
 
+/// The voxels OpenVDB holds for grids of g's topology (its layer opacity's): each leaf's 8^3
+/// whole, however few of them are active, and the voxels of its active tiles, which a grid made
+/// from it allocates once voxelized (the reference's light grids are).
+double allocatedVoxels(const TreeGrids& g);
+
 /// Throws BakeError unless `voxelSize_cm` is > 0 and at most a kilometre (a voxel that holds
 /// whole forests as one value; near 1e308 OpenVDB cannot invert its transform).
 void checkVoxelSize(double voxelSize_cm);
