@@ -344,28 +344,33 @@ TEST(FaithfulModels, TheReferencesNeedlesAreLitAsTheNeedlesAre)
 {
     // The long bough side-on under four lights, the reference's light against the needles'
     // (their mean over 4 rolls), in diffuse light alone (within 5%, as levels 2-3 along the
-    // branch) and through the bough itself. A needle lies on its cone's layer, so the light
-    // reaching it crosses the layers between it and the bough's edge, not the part of a layer
-    // that the line from a point between layers would also cross: read from such points, the
-    // reference's self-shadowed needles got 0.888, 0.743, 0.816 and 0.702 of the needles'
-    // light, now 0.980, 0.814, 0.885 and 0.790 (docs/models.md, "The reference's light").
-    // The layer models get 0.89-1.05 here (ALoneBoughUnderEveryLight): the bound below holds
-    // the gain, the 3% of issue 9 is not met under the three lights from aside and behind.
-    const char* lights[] = {"[0.3, -1, 0.6]", "[1, 0, 0.3]", "[0, 0, 1]", "[0.3, 1, 0.6]"};
-    for (const char* towards : lights) {
-        const auto [lit, shadowed] = needlesLight(towards);
-        const double d = referenceLight(kDiffuse, towards) / lit;
-        const double s = referenceLight(kSelfShadowed, towards) / shadowed;
+    // branch) and through the bough itself. A needle lies on its cone's layer, so the layers
+    // the light reaching it crosses lie where the line has crossed a whole number of layers
+    // from it, on its way out and, where it turns back through the layers past the axis, on
+    // its way back: read from points between layers, the reference's self-shadowed needles got
+    // 0.888, 0.743, 0.816 and 0.702 of the needles' light; with bands spread from the needle
+    // and the last divided out, 0.980, 0.814, 0.885 and 0.790; with the layers' places kept
+    // through the turn, 1.027, 0.861, 1.017 and 0.963 (docs/models.md, "The reference's
+    // light"). Along the branch the rest is unexplained (the layer models get 0.89-1.05 here,
+    // ALoneBoughUnderEveryLight).
+    struct Light {
+        const char* towards;
+        double tolerance;
+    };
+    const Light lights[] = {{"[0.3, -1, 0.6]", 0.05},
+                            {"[1, 0, 0.3]", 0.16},
+                            {"[0, 0, 1]", 0.05},
+                            {"[0.3, 1, 0.6]", 0.05}};
+    for (const Light& light : lights) {
+        const auto [lit, shadowed] = needlesLight(light.towards);
+        const double d = referenceLight(kDiffuse, light.towards) / lit;
+        const double s = referenceLight(kSelfShadowed, light.towards) / shadowed;
         std::printf(
             "reference lit towards %s, against the needles: diffuse alone %.3f, "
             "self-shadowed %.3f (the needles let %.3f through)\n",
-            towards, d, s, shadowed / lit);
-        EXPECT_NEAR(d, 1.0, 0.05) << towards;
-        EXPECT_GT(s, 0.77) << towards;
-        EXPECT_LT(s, 1.05) << towards;
-        if (towards == lights[0]) {
-            EXPECT_NEAR(s, 1.0, 0.05) << "the camera's side, above";
-        }
+            light.towards, d, s, shadowed / lit);
+        EXPECT_NEAR(d, 1.0, 0.05) << light.towards;
+        EXPECT_NEAR(s, 1.0, light.tolerance) << light.towards;
     }
 }
 

@@ -123,6 +123,54 @@ TEST(LayerBands, ABandEndsWhereTheLineTurnsBackOrLeavesTheMedium)
     }
 }
 
+/// The transmittance of a line from a layer through the layer positions `path` (signed layers
+/// crossed from the start, in order), each leg cut into random spans, at n needles a layer.
+double fromALayer(const std::vector<double>& path, double n, std::mt19937& rng)
+{
+    LayersFromALayer layers;
+    std::uniform_real_distribution<double> cut(0.0, 1.0);
+    double T = 1.0, at = 0.0;
+    for (const double to : path) {
+        std::vector<double> cuts{at, to};
+        for (int i = 0; i < 5; ++i) cuts.push_back(at + (to - at) * cut(rng));
+        std::sort(cuts.begin(), cuts.end());
+        if (to < at) std::reverse(cuts.begin(), cuts.end());
+        for (std::size_t i = 1; i < cuts.size(); ++i) {
+            const double k = cuts[i] - cuts[i - 1];
+            T *= layers.span(n * std::abs(k), k);
+        }
+        at = to;
+    }
+    return T;
+}
+
+TEST(LayersFromALayer, ALineFromANeedleMeetsTheLayersAtWholeCrossings)
+{
+    std::mt19937 rng(7);
+    for (const double n : {0.1, 0.45, 0.9}) {
+        // Out one way: the layers at 1, 2, ..., not its own at 0 nor the part crossed past the
+        // last (which bands spread from the start would stop n times over).
+        EXPECT_NEAR(fromALayer({2.6}, n, rng), std::pow(1.0 - n, 2), 1e-12) << n;
+        EXPECT_NEAR(fromALayer({-1.5}, n, rng), 1.0 - n, 1e-12) << n;
+        EXPECT_NEAR(fromALayer({0.999}, n, rng), 1.0, 1e-12) << n;
+        // Turning back past the axis at 2.6: the layers at 1 and 2 on the way out, at 2, 1 and
+        // its own cone's at 0 (another azimuth) on the way back to -0.5. Bands begun at the
+        // turn would meet 0.6 + 3.1 layers' needles there in place of 3.
+        EXPECT_NEAR(fromALayer({2.6, -0.5}, n, rng), std::pow(1.0 - n, 5), 1e-12) << n;
+        // Turning before the first layer: none met on the way out, its own on the way back.
+        EXPECT_NEAR(fromALayer({0.4, -0.2}, n, rng), 1.0 - n, 1e-12) << n;
+    }
+    // Where a line runs along the layers it meets none; needles more than a layer holds stop
+    // it at a crossing, never below 0 or as NaN (a ratio overflowing to infinity).
+    LayersFromALayer grazing;
+    EXPECT_EQ(grazing.span(0.5, 0.0), 1.0);
+    LayersFromALayer steep;
+    EXPECT_EQ(steep.span(3.0, 1.2), 0.0);
+    LayersFromALayer tiny;
+    EXPECT_EQ(tiny.span(0.01, 1e-320), 1.0);  // 0.01 / 1e-320 overflows; no layer met
+    EXPECT_NEAR(tiny.span(0.01, 1.0), 0.99, 1e-12);
+}
+
 TEST(LayerBands, OneCrossingOfAPaperBoughStopsALineWithItsNeedlesProjectedWidth)
 {
     // From the bough's own geometry, not the sampled fields: the needles of the cone through x

@@ -102,21 +102,21 @@ struct FieldReader {
 // One line's spans through the field, in order: the transmittance of each, exp(-sigma dt) for
 // an extinction law, the bands of evenly spaced needles for a banded one (layer_bands.h).
 //
-// A line from a needle's point (towards a light) starts on one of its bough's layers, where
-// the bands, drawn from where a line starts, assume no phase: each band's needles are spread
-// along it. From a layer, the layers lie at the bands' ends, so the band in which the line
-// leaves the point's bough holds no layer, though it stopped 1 - openBand() of the light
-// (half a layer's opacity on average: the reference's needles read 16-19% dark under
-// self-shadowing on three firs, docs/models.md). attenuated() divides that band out where the
-// line leaves the bough: at a gap in the medium or a voxel of none. Boughs met farther on are
-// met at any phase.
+// A line from a needle's point (towards a light) starts on one of its bough's layers: there
+// the layers lie where it has crossed a whole number of them, on its way out and, past the
+// axis, on its way back (LayersFromALayer), where bands assume no phase, spreading each
+// layer's needles along a band begun where the line starts or turns. Bands counted half a
+// layer too many where the line left the bough and again at each turn: the reference's
+// needles read 16-19% dark under self-shadowing on three firs, docs/models.md. The point's
+// bough ends at a gap in the medium or a voxel of none; boughs met farther on are met at any
+// phase.
 class LineThroughField {
 public:
     explicit LineThroughField(const bake::ExtinctionLaw& law) : mBanded(law.banded()) {}
     /// A line from a needle's point, on a layer: `gap_cm` is how far apart two spans may be
     /// and still be one stretch of the point's bough.
     LineThroughField(const bake::ExtinctionLaw& law, double gap_cm)
-        : mBanded(law.banded()), mOnOwnBough(true), mGap_cm(gap_cm)
+        : mBanded(law.banded()), mOnOwnBough(mBanded), mGap_cm(gap_cm)
     {
     }
 
@@ -133,25 +133,18 @@ public:
     /// T, the line's transmittance up to the span, carried across it.
     double attenuated(double T, const FieldReader::Rates& r, double ta, double tb)
     {
-        if (mOnOwnBough && (ta > mOwnEnd + mGap_cm || !(r.sigma > 0.0))) T = leaveOwnBough(T);
-        if (mOnOwnBough) mOwnEnd = tb;
-        return T * transmittance(r, ta, tb);
+        if (mOnOwnBough && (ta > mOwnEnd + mGap_cm || !(r.sigma > 0.0))) mOnOwnBough = false;
+        if (!mOnOwnBough) return T * transmittance(r, ta, tb);
+        mOwnEnd = tb;
+        return T * mOwn.span(r.sigma * (tb - ta), r.layers * (tb - ta));
     }
-    /// T at the line's end (the point's bough may reach that far).
-    double finished(double T) { return mOnOwnBough && T > 0.0 ? leaveOwnBough(T) : T; }
 
 private:
-    double leaveOwnBough(double T)
-    {
-        mOnOwnBough = false;
-        const double open = mBanded ? mBands.openBand() : 1.0;
-        return open > 0.0 ? T / open : T;
-    }
-
     bool mBanded;
     LayerBands mBands;
     double mEnd = -std::numeric_limits<double>::infinity();
-    bool mOnOwnBough = false;
+    bool mOnOwnBough = false;  ///< a line from a needle's point, still in its bough
+    LayersFromALayer mOwn;
     double mGap_cm = 0.0, mOwnEnd = 0.0;
 };
 
@@ -220,7 +213,6 @@ public:
         march(thread, x, L, tMax, [&](const openvdb::Coord& ijk, double ta, double tb) {
             if (T > 0.0) T = line.attenuated(T, thread.field.rates(ijk, L), ta, tb);
         });
-        T = line.finished(T);
         if (mPlan.shadowRays) {
             T *= shadowConeTransmittance(mScene, x, light, footprint_cm, self, false);
         }

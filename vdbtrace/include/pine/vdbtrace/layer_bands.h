@@ -7,6 +7,7 @@
 // A voxel's field does not say where its cone lies, so the bands are drawn from where the line
 // enters the medium: a band ends where d . G changes sign (the line turns back through the
 // layers, as where it grazes a cone) or once it has crossed one whole layer.
+// A line that starts on a layer (from a needle) knows where its layers lie: LayersFromALayer.
 #pragma once
 
 #include <algorithm>
@@ -58,9 +59,6 @@ public:
         return T;
     }
 
-    /// What the band begun last, and not yet crossed whole, lets through so far (1 if none).
-    double openBand() const { return mCrossed < 1.0 ? 1.0 - std::min(1.0, mNeedles) : 1.0; }
-
 private:
     void begin()
     {
@@ -79,6 +77,32 @@ private:
     double mNeedles = 0.0;  ///< met in the current band so far
     double mCrossed = 1.0;  ///< layers crossed in the current band; 1: none begun
     double mSign = 0.0;     ///< of d . G in the current band
+};
+
+/// The layers of a line that starts on one of them (a needle's point): where they lie is known,
+/// at every whole number of layers crossed from the start, counted signed, so that a line
+/// turning back through the layers (g, concave along a line, rises to a maximum near where it
+/// passes the axis, then falls) meets the same layer positions on its way back, and its own layer
+/// again. Bands begun at the turn would spread a layer over the band: from a needle, each turn
+/// would count half a layer more than the line meets on average.
+class LayersFromALayer {
+public:
+    /// As LayerBands::span: the next span, `needles` met on average, `layers` crossed (signed).
+    double span(double needles, double layers)
+    {
+        const double from = mCrossed;
+        mCrossed += layers;
+        // Layer positions passed: integers in (from, to] rising, [to, from) falling; the
+        // start's own layer, 0, is not met leaving it either way.
+        const double met = layers > 0.0   ? std::floor(mCrossed) - std::floor(from)
+                           : layers < 0.0 ? std::ceil(from) - std::ceil(mCrossed)
+                                          : 0.0;
+        if (!(met > 0.0) || !(needles > 0.0)) return 1.0;
+        return std::pow(1.0 - std::min(1.0, needles / std::abs(layers)), met);
+    }
+
+private:
+    double mCrossed = 0.0;  ///< layers crossed from the start, signed
 };
 
 }  // namespace pine::vdbtrace
