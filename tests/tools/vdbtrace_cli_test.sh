@@ -351,8 +351,14 @@ if [ -x "$bake" ]; then
     "$bake" tree "$src/scenes/three-firs.json" --tree 1 --voxel-size 1 --out "$work/t1.vdb" \
         2>/dev/null || fail "bake tree --tree 1 failed"
     "$vdbtrace" render "$src/scenes/three-firs.json" --method reference --grids "$work/t1.vdb" \
-        --subpixels 1 --resolution 80x60 --out "$work/r1.exr" 2>/dev/null \
+        --subpixels 1 --resolution 80x60 --out "$work/r1.exr" 2>"$work/err" \
         || fail "reference from tree 1's grids failed"
+    # Its light grids, before any pixel, tell their progress on lines of their own.
+    grep -E "^vdbtrace: (lighting [0-9]+ voxels|rendering) +[0-9]+%$" "$work/err" | awk '
+        /lighting/ { if (rendering) bad = 1; lit = $NF }
+        /rendering/ { rendering = 1 }
+        END { exit bad || lit != "100%" || !rendering }' \
+        || fail "the reference's light grids' progress: $(grep % "$work/err" | tr '\n' ' ')"
     oiiotool --info -v "$work/r1.exr" | /usr/bin/python3 -c '
 import json, re, sys
 rows = json.loads(json.loads(re.search(r"pine:tree_foliage: (\".*\")", sys.stdin.read()).group(1)))

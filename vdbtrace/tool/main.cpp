@@ -50,6 +50,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -67,6 +68,32 @@ vdbtrace::RenderOptions withProgress(tool::Progress& shown)
     options.progress = [&shown](double fraction) { shown.update(fraction); };
     return options;
 }
+
+/// A method's preparation (RenderOptions::preparing), each stage a progress line of its own
+/// ("vdbtrace: lighting 1234 voxels  40%"), ended before the pixels' line begins.
+class PreparingShown {
+public:
+    void operator()(const std::string& stage, double fraction)
+    {
+        const std::lock_guard<std::mutex> lock(mMutex);
+        if (stage != mStage) {
+            if (mShown) mShown->finish();
+            mShown.emplace("vdbtrace: " + stage);
+            mStage = stage;
+        }
+        mShown->update(fraction);
+    }
+    void finish()
+    {
+        const std::lock_guard<std::mutex> lock(mMutex);
+        if (mShown) mShown->finish();
+    }
+
+private:
+    std::mutex mMutex;
+    std::string mStage;
+    std::optional<tool::Progress> mShown;
+};
 
 // The command line's choice of models, over the scene's (render.preset and the keys after
 // it): --paper first, then each law named.
@@ -611,6 +638,11 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         tool::Progress rendering(f ? "vdbtrace: frame " + std::to_string(*f)
                                    : std::string("vdbtrace: rendering"));
         vdbtrace::RenderOptions options = withProgress(rendering);
+        PreparingShown preparing;
+        options.preparing = [&preparing](const std::string& stage, double fraction) {
+            preparing(stage, fraction);
+            if (fraction >= 1.0) preparing.finish();
+        };
         options.window = window;
         vdbtrace::RenderResult result = method.render(loaded->traced, settings, options);
         rendering.finish();

@@ -6,6 +6,7 @@
 #include "pine/vdbtrace/tree_foliage_tally.h"
 
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace pine::vdbtrace {
@@ -32,6 +33,9 @@ struct RenderOptions {
     PixelWindow window;
     /// Called from worker threads with the fraction done, at most every 2%.
     std::function<void(double)> progress;
+    /// What a method prepares before its pixels, where that is long (the reference's light
+    /// grids): the stage's name and its fraction done, from worker threads, at most every 1%.
+    std::function<void(const std::string& stage, double fraction)> preparing;
 };
 
 struct RenderResult {
