@@ -148,8 +148,8 @@ TEST(LayersFromALayer, ALineFromANeedleMeetsTheLayersAtWholeCrossings)
 {
     std::mt19937 rng(7);
     for (const double n : {0.1, 0.45, 0.9}) {
-        // Out one way: the layers at 1, 2, ..., not its own at 0 nor the part crossed past the
-        // last (which bands spread from the start would stop n times over).
+        // Out one way: the layers at 1, 2, ..., not its own at 0, and none in the part crossed
+        // past the last (where bands spread from the start stop 0.6 n of the light).
         EXPECT_NEAR(fromALayer({2.6}, n, rng), std::pow(1.0 - n, 2), 1e-12) << n;
         EXPECT_NEAR(fromALayer({-1.5}, n, rng), 1.0 - n, 1e-12) << n;
         EXPECT_NEAR(fromALayer({0.999}, n, rng), 1.0, 1e-12) << n;

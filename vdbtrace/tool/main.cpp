@@ -46,6 +46,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -70,7 +71,7 @@ vdbtrace::RenderOptions withProgress(tool::Progress& shown)
 }
 
 /// A method's preparation (RenderOptions::preparing), each stage a progress line of its own
-/// ("vdbtrace: lighting 1234 voxels  40%"), ended before the pixels' line begins.
+/// ("vdbtrace: lighting 1234 voxels  40%"), ended when done, before the pixels' line begins.
 class PreparingShown {
 public:
     void operator()(const std::string& stage, double fraction)
@@ -82,11 +83,7 @@ public:
             mStage = stage;
         }
         mShown->update(fraction);
-    }
-    void finish()
-    {
-        const std::lock_guard<std::mutex> lock(mMutex);
-        if (mShown) mShown->finish();
+        if (fraction >= 1.0) mShown->finish();
     }
 
 private:
@@ -639,10 +636,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                                    : std::string("vdbtrace: rendering"));
         vdbtrace::RenderOptions options = withProgress(rendering);
         PreparingShown preparing;
-        options.preparing = [&preparing](const std::string& stage, double fraction) {
-            preparing(stage, fraction);
-            if (fraction >= 1.0) preparing.finish();
-        };
+        options.preparing = std::ref(preparing);
         options.window = window;
         vdbtrace::RenderResult result = method.render(loaded->traced, settings, options);
         rendering.finish();
