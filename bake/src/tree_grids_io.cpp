@@ -460,8 +460,9 @@ ReadGrids readTreeGrids(const fs::path& path, double maxMemoryBytes)
         // Under the caller's limit, a sound file may fail as a damaged one does (OpenVDB
         // aborts or crashes where an allocation fails): say which limit it was.
         const bool outOfMemory = trial.kind == io::IsolatedOutcome::Kind::OutOfMemory;
+        const bool crashed = trial.kind == io::IsolatedOutcome::Kind::Crashed;
         const std::string cause =
-            limit < soundFileCap
+            limit < soundFileCap && (outOfMemory || crashed)
                 ? (outOfMemory ? "" : " within the memory limit of " + formatBytes(limit)) +
                       " (the limit too low for a file of " + formatBytes(size) +
                       ", or the file damaged)"

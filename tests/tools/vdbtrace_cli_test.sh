@@ -354,7 +354,7 @@ if [ -x "$bake" ]; then
         --subpixels 1 --resolution 80x60 --out "$work/r1.exr" 2>"$work/err" \
         || fail "reference from tree 1's grids failed"
     # Its light grids, before any pixel, tell their progress on lines of their own.
-    grep -E "^vdbtrace: (lighting [0-9]+ voxels|rendering) +[0-9]+%$" "$work/err" | awk '
+    grep -E "^vdbtrace: (lighting [0-9]+ voxels( for [0-9]+ lights)?|rendering) +[0-9]+%$" "$work/err" | awk '
         /lighting/ { if (rendering) bad = 1; lit = $NF }
         /rendering/ { rendering = 1 }
         END { exit bad || lit != "100%" || !rendering }' \

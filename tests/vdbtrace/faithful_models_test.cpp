@@ -355,12 +355,12 @@ TEST(FaithfulModels, TheReferencesNeedlesAreLitAsTheNeedlesAre)
     // ALoneBoughUnderEveryLight).
     struct Light {
         const char* towards;
-        double tolerance;
+        double least;  ///< of the reference's self-shadowed light over the needles'
     };
-    const Light lights[] = {{"[0.3, -1, 0.6]", 0.05},
-                            {"[1, 0, 0.3]", 0.16},
-                            {"[0, 0, 1]", 0.05},
-                            {"[0.3, 1, 0.6]", 0.05}};
+    const Light lights[] = {{"[0.3, -1, 0.6]", 0.95},
+                            {"[1, 0, 0.3]", 0.84},
+                            {"[0, 0, 1]", 0.95},
+                            {"[0.3, 1, 0.6]", 0.95}};
     for (const Light& light : lights) {
         const auto [lit, shadowed] = needlesLight(light.towards);
         const double d = referenceLight(kDiffuse, light.towards) / lit;
@@ -370,7 +370,8 @@ TEST(FaithfulModels, TheReferencesNeedlesAreLitAsTheNeedlesAre)
             "self-shadowed %.3f (the needles let %.3f through)\n",
             light.towards, d, s, shadowed / lit);
         EXPECT_NEAR(d, 1.0, 0.05) << light.towards;
-        EXPECT_NEAR(s, 1.0, light.tolerance) << light.towards;
+        EXPECT_GT(s, light.least) << light.towards;
+        EXPECT_LT(s, 1.05) << light.towards;
     }
 }
 

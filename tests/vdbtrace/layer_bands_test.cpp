@@ -160,6 +160,17 @@ TEST(LayersFromALayer, ALineFromANeedleMeetsTheLayersAtWholeCrossings)
         // Turning before the first layer: none met on the way out, its own on the way back.
         EXPECT_NEAR(fromALayer({0.4, -0.2}, n, rng), 1.0 - n, 1e-12) << n;
     }
+    // Ending a span on a layer's place: met once, on whichever side the line goes on.
+    for (const double n : {0.2, 0.7}) {
+        LayersFromALayer up;
+        EXPECT_NEAR(up.span(n, 1.0) * up.span(0.5 * n, -0.5), 1.0 - n, 1e-12);
+        LayersFromALayer down;  // its own layer at 0 again on the way back
+        EXPECT_NEAR(down.span(n, -1.0) * down.span(1.5 * n, 1.5), (1.0 - n) * (1.0 - n), 1e-12);
+    }
+    // A non-finite gradient stops what its needles stop, and the layers keep their places.
+    LayersFromALayer broken;
+    EXPECT_NEAR(broken.span(0.4, std::nan("")), 0.6, 1e-12);
+    EXPECT_NEAR(broken.span(0.5, 1.0), 0.5, 1e-12);
     // Where a line runs along the layers it meets none; needles more than a layer holds stop
     // it at a crossing, never below 0 or as NaN (a ratio overflowing to infinity).
     LayersFromALayer grazing;

@@ -108,9 +108,10 @@ struct FieldReader {
 // axis, on its way back (LayersFromALayer), where bands assume no phase, spreading each
 // layer's needles along a band begun where the line starts or turns. Bands counted half a
 // layer too many where the line left the bough and again at each turn: the reference's
-// needles read 16-19% dark under self-shadowing on three firs, docs/models.md. The point's
-// bough ends at a gap in the medium or a voxel of none; boughs met farther on are met at any
-// phase.
+// needles read 16-19% dark under self-shadowing on three firs, docs/models.md. (The light
+// grid's lines start at voxel centres, each standing for the needles of its voxel.) The
+// point's bough ends at a gap in the medium or a voxel of none, and boughs met after it at any
+// phase; a bough touching it with no gap is counted on as if its layers were in step.
 class LineThroughField {
 public:
     explicit LineThroughField(const bake::ExtinctionLaw& law) : mBanded(law.banded()) {}

@@ -90,6 +90,9 @@ public:
     /// As LayerBands::span: the next span, `needles` met on average, `layers` crossed (signed).
     double span(double needles, double layers)
     {
+        // A field read from elsewhere may hold a non-finite gradient: its needles stop the
+        // line as one layer's would, and where the layers lie stays known.
+        if (!std::isfinite(layers)) return needles > 0.0 ? 1.0 - std::min(1.0, needles) : 1.0;
         const double from = mCrossed;
         mCrossed += layers;
         // Layer positions passed: integers in (from, to] rising, [to, from) falling; the
