@@ -1,9 +1,15 @@
 // The render loop every method shares, driven by a method whose fragments are known: what a
 // pixel's RGBA and AOVs mean, whatever method supplied them.
-#include "pine/scenes/scene.h"
 #include "pine/vdbtrace/render_driver.h"
+#include "pine/scenes/scene.h"
+#include "pine/vdbtrace/progress_steps.h"
 
 #include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <mutex>
+#include <vector>
 
 #include <limits>
 
@@ -112,6 +118,32 @@ TEST(RenderDriver, RadianceTooLargeForAFloatIsAnErrorNotAPixel)
         EXPECT_NE(std::string(e.what()).find("radiance overflowed: 6 pixel values"),
                   std::string::npos)
             << e.what();
+    }
+}
+
+TEST(ProgressSteps, EachStepIsToldOnceEndingAtTheWhole)
+{
+    // Units finished on every thread, told in 50 steps: no step twice, the last at 1, and a
+    // unit that finishes no new step tells nothing.
+    for (const std::size_t total : {std::size_t(1000), std::size_t(7)}) {
+        ProgressSteps steps(total, 50);
+        std::mutex mutex;
+        std::vector<double> told;
+        tbb::parallel_for(std::size_t(0), total, [&](std::size_t) {
+            double fraction;
+            if (!steps.finished(fraction)) return;
+            const std::lock_guard<std::mutex> lock(mutex);
+            told.push_back(fraction);
+        });
+        ASSERT_FALSE(told.empty());
+        EXPECT_LE(told.size(), std::min<std::size_t>(total, 50)) << total;
+        EXPECT_EQ(*std::max_element(told.begin(), told.end()), 1.0) << total;
+        std::vector<int> stepsTold;
+        for (const double f : told)
+            stepsTold.push_back(int(std::lround(f * double(total))) * 50 / int(total));
+        std::sort(stepsTold.begin(), stepsTold.end());
+        EXPECT_EQ(std::adjacent_find(stepsTold.begin(), stepsTold.end()), stepsTold.end())
+            << "a step told twice";
     }
 }
 

@@ -4,6 +4,7 @@
 #include "pine/bake/extinction_law.h"
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/layer_bands.h"
+#include "pine/vdbtrace/progress_steps.h"
 #include "pine/vdbtrace/render_driver.h"
 #include "pine/vdbtrace/surface_shading.h"
 
@@ -14,7 +15,6 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -317,8 +317,7 @@ Reference::Reference(const TracedScene& scene, const bake::TreeGrids& grids,
     // reference against the needles by about what that half voxel stops (docs/models.md).
     // Minutes on a forest at 0.25 cm: told by the leaves lit, over every light.
     const std::size_t lights = mScene.lights.size();
-    std::atomic<std::size_t> lit{0};
-    std::atomic<int> told{-1};
+    std::optional<ProgressSteps> steps;
     std::string stage;
     for (std::size_t li = 0; li < lights; ++li) {
         auto grid = openvdb::FloatGrid::create(1.0f);
@@ -328,8 +327,8 @@ Reference::Reference(const TracedScene& scene, const bake::TreeGrids& grids,
         openvdb::tools::dilateActiveValues(grid->tree(), 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
                                            openvdb::tools::EXPAND_TILES);
         openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid->tree());
-        const double total = double(leaves.leafCount()) * double(lights);
         if (li == 0) {
+            steps.emplace(leaves.leafCount() * lights, 100);
             stage = "lighting " + std::to_string(grid->activeVoxelCount()) + " voxels" +
                     (lights > 1 ? " for " + std::to_string(lights) + " lights" : "");
         }
@@ -340,13 +339,8 @@ Reference::Reference(const TracedScene& scene, const bake::TreeGrids& grids,
                 const Vec3 x(c.x(), c.y(), c.z());
                 it.setValue(float(transmittance(thread, x, li, mH, kNoPrimitive, true)));
             }
-            if (!preparing) return;
-            const double done = double(++lit) / total;
-            const int percent = int(100.0 * done);
-            int last = told.load();
-            while (percent > last && !told.compare_exchange_weak(last, percent)) {
-            }
-            if (percent > last) preparing(stage, done);
+            double fraction;
+            if (steps->finished(fraction) && preparing) preparing(stage, fraction);
         });
         mLightTransmittance.push_back(grid);
     }

@@ -2,12 +2,12 @@
 // (render_driver.cpp).
 #pragma once
 
+#include "pine/vdbtrace/progress_steps.h"
 #include "pine/vdbtrace/render_stats.h"
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <atomic>
 #include <functional>
 #include <mutex>
 
@@ -33,7 +33,7 @@ void forEachTile(int width, int height, int tile, const std::function<void(doubl
     const int tilesX = (width + tile - 1) / tile;
     const int tiles = tileCount(width, height, tile);
     std::mutex statsMutex;
-    std::atomic<int> done{0}, reported{0};
+    ProgressSteps steps(std::size_t(tiles), 50);
     tbb::parallel_for(0, tiles, [&](int k) {
         RenderStats stats;
         const int x0 = (k % tilesX) * tile, y0 = (k / tilesX) * tile;
@@ -42,13 +42,8 @@ void forEachTile(int width, int height, int tile, const std::function<void(doubl
             std::lock_guard<std::mutex> lock(statsMutex);
             total += stats;
         }
-        const int finished = ++done;
-        if (!progress) return;
-        const int percent = finished * 50 / tiles;
-        int last = reported.load();
-        while (percent > last && !reported.compare_exchange_weak(last, percent)) {
-        }
-        if (percent > last) progress(double(finished) / tiles);
+        double fraction;
+        if (steps.finished(fraction) && progress) progress(fraction);
     });
 }
 
