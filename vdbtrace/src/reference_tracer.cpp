@@ -64,6 +64,27 @@ void walkVoxels(const Vec3& o, const Vec3& d, double h, double t0, double t1, Vi
     }
 }
 
+// Calls visit(ijk, ta, tb) for each voxel span of o + t d, t in [0, tMax], in order, through the
+// active parts of the grid `intersector` was made for (voxels of size h).
+template <class Visit>
+void marchVoxels(Intersector& intersector, double h, const Vec3& o, const Vec3& d, double tMax,
+                 Visit&& visit)
+{
+    // OpenVDB's rays start after t = 0 (Ray::setTimes asserts t0 > 0, which a debug build
+    // checks): the 1e-9 cm skipped is far below any voxel.
+    const double tStart = openvdb::math::Delta<double>::value();
+    if (!(tMax > tStart)) return;
+    using RayT = openvdb::math::Ray<double>;
+    const RayT ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), tStart, tMax);
+    if (!intersector.setWorldRay(ray)) return;
+    double i0, i1;
+    while (intersector.march(i0, i1)) {
+        const double w0 = std::max(0.0, intersector.getWorldTime(i0));
+        const double w1 = std::min(tMax, intersector.getWorldTime(i1));
+        walkVoxels(o, d, h, w0, w1, visit);
+    }
+}
+
 // The grids as one thread reads them, through the extinction law they were baked with.
 struct FieldReader {
     const bake::ExtinctionLaw& law;
@@ -150,6 +171,17 @@ private:
     double mGap_cm = 0.0, mOwnEnd = 0.0;
 };
 
+// The light o + t d, t in [0, tMax], lets through the field, read by `line`'s rule.
+double lineTransmittance(Intersector& intersector, FieldReader& field, double h,
+                         LineThroughField line, const Vec3& o, const Vec3& d, double tMax)
+{
+    double T = 1.0;
+    marchVoxels(intersector, h, o, d, tMax, [&](const openvdb::Coord& ijk, double ta, double tb) {
+        if (T > 0.0) T = line.attenuated(T, field.rates(ijk, d), ta, tb);
+    });
+    return T;
+}
+
 class ReferenceRayTracer;
 
 // What every thread shares: the grids, their intersector, and the light reaching each voxel.
@@ -184,21 +216,7 @@ public:
     template <class Visit>
     void march(Thread& thread, const Vec3& o, const Vec3& d, double tMax, Visit&& visit) const
     {
-        if (!mHasVolume) return;
-        // OpenVDB's rays start after t = 0 (Ray::setTimes asserts t0 > 0, which a debug build
-        // checks): the 1e-9 cm skipped is far below any voxel.
-        const double tStart = openvdb::math::Delta<double>::value();
-        if (!(tMax > tStart)) return;
-        using RayT = openvdb::math::Ray<double>;
-        const RayT ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), tStart, tMax);
-        Intersector& intersector = *thread.intersector;
-        if (!intersector.setWorldRay(ray)) return;
-        double i0, i1;
-        while (intersector.march(i0, i1)) {
-            const double w0 = std::max(0.0, intersector.getWorldTime(i0));
-            const double w1 = std::min(tMax, intersector.getWorldTime(i1));
-            walkVoxels(o, d, mH, w0, w1, visit);
-        }
+        if (mHasVolume) marchVoxels(*thread.intersector, mH, o, d, tMax, visit);
     }
 
     /// Transmittance from x to light `light` through the grids, and with shadows through the
@@ -212,11 +230,12 @@ public:
         mScene.lights[light].at(x, L, distance, irradiance);
         const double tMax = std::isfinite(distance) ? distance : 1e7;
         double T = 1.0;
-        LineThroughField line = onLayer ? LineThroughField(thread.field.law, 1e-6 * mH)
-                                        : LineThroughField(thread.field.law);
-        march(thread, x, L, tMax, [&](const openvdb::Coord& ijk, double ta, double tb) {
-            if (T > 0.0) T = line.attenuated(T, thread.field.rates(ijk, L), ta, tb);
-        });
+        if (mHasVolume) {
+            T = lineTransmittance(*thread.intersector, thread.field, mH,
+                                  onLayer ? LineThroughField(thread.field.law, 1e-6 * mH)
+                                          : LineThroughField(thread.field.law),
+                                  x, L, tMax);
+        }
         if (mPlan.shadowRays) {
             T *= shadowConeTransmittance(mScene, x, light, footprint_cm, self, false);
         }
@@ -423,6 +442,32 @@ void ReferenceRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
 }
 
 }  // namespace
+
+struct FieldTransmittance::Reader {
+    explicit Reader(const bake::TreeGrids& g)
+        : intersector(*g.layerOpacity), field(g), h(g.voxelSize_cm)
+    {
+    }
+    Intersector intersector;
+    FieldReader field;
+    double h;
+};
+
+FieldTransmittance::FieldTransmittance(const bake::TreeGrids& grids)
+    : mReader(grids.layerOpacity && grids.layerOpacity->activeVoxelCount() > 0
+                  ? std::make_unique<Reader>(grids)
+                  : nullptr)
+{
+}
+
+FieldTransmittance::~FieldTransmittance() = default;
+
+double FieldTransmittance::operator()(const Vec3& o, const Vec3& d, double tMax)
+{
+    if (!mReader) return 1.0;
+    return lineTransmittance(mReader->intersector, mReader->field, mReader->h,
+                             LineThroughField(mReader->field.law), o, d, tMax);
+}
 
 RenderResult renderReference(const TracedScene& scene, const bake::TreeGrids& grids,
                              const ReferenceOptions& method, const RenderOptions& options)

@@ -14,6 +14,8 @@
 #include "pine/vdbtrace/render_result.h"
 #include "pine/vdbtrace/traced_scene.h"
 
+#include <memory>
+
 namespace pine::vdbtrace {
 
 struct ReferenceOptions {
@@ -37,5 +39,21 @@ inline bake::BakeSettings referenceBake(double voxelSize_cm)
 RenderResult renderReference(const TracedScene& scene, const bake::TreeGrids& grids,
                              const ReferenceOptions& method = {},
                              const RenderOptions& options = {});
+
+/// The light a line lets through baked grids, read as the reference reads a line that starts
+/// outside the boughs (layer_bands.h); no branches. The
+/// field's own transmittance, for tests and studies. One thread's: reading the grids for a
+/// line needs an intersector of their topology, made once here.
+class FieldTransmittance {
+public:
+    explicit FieldTransmittance(const bake::TreeGrids& grids);  ///< `grids` outlive this
+    ~FieldTransmittance();
+    /// The line o + t d (d unit), t in [0, tMax].
+    double operator()(const Vec3& o, const Vec3& d, double tMax);
+
+private:
+    struct Reader;
+    std::unique_ptr<Reader> mReader;
+};
 
 }  // namespace pine::vdbtrace
