@@ -124,15 +124,16 @@ struct FieldReader {
 // One line's spans through the field, in order: the transmittance of each, exp(-sigma dt) for
 // an extinction law, the bands of evenly spaced needles for a banded one (layer_bands.h).
 //
-// A line from a needle's point (towards a light) starts on one of its bough's layers: there
-// the layers lie where it has crossed a whole number of them, on its way out and, past the
-// axis, on its way back (LayersFromALayer), where bands assume no phase, spreading each
-// layer's needles along a band begun where the line starts or turns. Bands counted half a
-// layer too many where the line left the bough and again at each turn: the reference's
-// needles read 16-19% dark under self-shadowing on three firs, docs/models.md. (The light
-// grid's lines start at voxel centres, each standing for the needles of its voxel.) The
-// point's bough ends at a gap in the medium or a voxel of none, and boughs met after it at any
-// phase; a bough touching it with no gap is counted on as if its layers were in step.
+// A line that enters a bough from outside (a view's line, or a light's past its own bough)
+// meets its layers at an unknown phase, and LayerBands averages over it. A line from a
+// needle's point (towards a light) starts on one of its bough's layers: there the layers lie
+// where it has crossed a whole number of them, on its way out and, past the axis, on its way
+// back (LayersFromALayer); bands spread from the point counted half a layer too many where the
+// line left the bough and again at each turn (the reference's needles read 16-19% dark under
+// self-shadowing on three firs, docs/models.md). (The light grid's lines start at voxel
+// centres, each standing for the needles of its voxel.) The point's bough ends at a gap in the
+// medium or a voxel of none, and boughs met after it at a phase of their own; a bough touching
+// it with no gap is counted on as if its layers were in step.
 class LineThroughField {
 public:
     explicit LineThroughField(const bake::ExtinctionLaw& law) : mBanded(law.banded()) {}

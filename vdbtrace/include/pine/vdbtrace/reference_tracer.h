@@ -41,7 +41,7 @@ RenderResult renderReference(const TracedScene& scene, const bake::TreeGrids& gr
                              const RenderOptions& options = {});
 
 /// The light a line lets through baked grids, read as the reference reads a line that starts
-/// outside the boughs (layer_bands.h); no branches. The
+/// outside the boughs (layer_bands.h: the layers at an unknown phase); no branches. The
 /// field's own transmittance, for tests and studies. One thread's: reading the grids for a
 /// line needs an intersector of their topology, made once here.
 class FieldTransmittance {
