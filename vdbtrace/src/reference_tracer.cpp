@@ -461,6 +461,8 @@ FieldTransmittance::FieldTransmittance(const bake::TreeGrids& grids)
 {
 }
 
+FieldTransmittance::FieldTransmittance(FieldTransmittance&&) noexcept = default;
+FieldTransmittance& FieldTransmittance::operator=(FieldTransmittance&&) noexcept = default;
 FieldTransmittance::~FieldTransmittance() = default;
 
 double FieldTransmittance::operator()(const Vec3& o, const Vec3& d, double tMax)

@@ -47,6 +47,8 @@ RenderResult renderReference(const TracedScene& scene, const bake::TreeGrids& gr
 class FieldTransmittance {
 public:
     explicit FieldTransmittance(const bake::TreeGrids& grids);  ///< `grids` outlive this
+    FieldTransmittance(FieldTransmittance&&) noexcept;          ///< one a thread, in a vector
+    FieldTransmittance& operator=(FieldTransmittance&&) noexcept;
     ~FieldTransmittance();
     /// The line o + t d (d unit), t in [0, tMax].
     double operator()(const Vec3& o, const Vec3& d, double tMax);
