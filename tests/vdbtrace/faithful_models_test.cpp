@@ -417,11 +417,10 @@ TEST(FaithfulModels, ALineThroughABoughAtEveryAngle)
     // layer model (cone_crossings.h: the bands where the cones lie) and the reference's field
     // (its bands at an unknown phase, layer_bands.h) at 0.25 and 0.125 cm, each over the
     // lines within a coarse voxel of the region. Measured: the layer model 0.949 to 1.040 of
-    // the needles down to 20 degrees; the field 0.951-0.963 of the model at 0.25 cm and
-    // within 0.8% at 0.125. With
-    // its bands begun where a line enters (until 2026-12-06) the field let through 0.914-0.93
-    // of the model at 0.25 cm and 0.967 side-on at 0.125 (docs/models.md, "The reference's
-    // light").
+    // the needles down to 20 degrees; the field 0.951-0.963 of the model at 0.25 cm and within
+    // 0.8% at 0.125. With its bands begun where a line enters (until 2026-12-06) the field let
+    // through 0.914-0.93 of the model at 0.25 cm and 0.967 side-on at 0.125 (docs/models.md,
+    // "The reference's light").
     const LongBough s(90.0, {});
     const TracedBough& b = s.traced.boughs.front();  // along x, from -100 to 100 cm
     const NeedleLayout needles(b);
