@@ -355,7 +355,7 @@ namespace {
 
 /// The grids in `bytes`, read from `path`, checked as readTreeGrids promises, in the scene's
 /// world in cm. `verified`: a manifest vouched for the bytes.
-ReadGrids parseTreeGrids(const std::string& bytes, const fs::path& path, bool verified)
+ReadGrids parseGrids(const std::string& bytes, const fs::path& path, bool verified)
 {
     openvdb::GridPtrVecPtr grids;
     openvdb::MetaMap::Ptr meta;
@@ -427,6 +427,17 @@ ReadGrids parseTreeGrids(const std::string& bytes, const fs::path& path, bool ve
         out.tree->setTransform(out.density->transform().copy());
     }
     return read;
+}
+
+/// parseGrids, with what OpenVDB throws once the stream is read (a damaged map of zero scale
+/// throws ArithmeticError where it is used) refused as the file's.
+ReadGrids parseTreeGrids(const std::string& bytes, const fs::path& path, bool verified)
+{
+    try {
+        return parseGrids(bytes, path, verified);
+    } catch (const openvdb::Exception& e) {
+        throw BakeError("cannot read '" + path.string() + "': " + e.what());
+    }
 }
 
 }  // namespace

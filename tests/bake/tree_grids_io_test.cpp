@@ -431,6 +431,44 @@ TEST(TreeGridsIo, WhatOpenVdbCannotReadIsABakeError)
     expectRefused(file, "cannot read");
 }
 
+TEST(TreeGridsIo, AGridWithAZeroScaleIsRefusedNamingItsFile)
+{
+    // A flipped bit that makes a grid's voxel size 0 (the fuzz found one in a checkout whose
+    // path moved the damage there): OpenVDB reads the stream, then throws ArithmeticError
+    // building the map, which reached the user without the file's name. Each double of the
+    // file equal to the density grid's voxel size (in file units) zeroed in turn, with a
+    // matching manifest: refused, naming the file, on one line.
+    const test::TempDir dir;
+    const fs::path good = written(dir);
+    const std::string bytes = readFile(good);
+    double scale = 0.0;
+    {
+        std::istringstream in(bytes, std::ios::binary);
+        openvdb::io::Stream stream(in, /*delayLoad=*/false);
+        scale = stream.getGrids()->front()->voxelSize()[0];
+    }
+    ASSERT_GT(scale, 0.0);
+    const std::string needle(reinterpret_cast<const char*>(&scale), sizeof scale);
+    const fs::path file = dir.path() / "zero-scale.vdb";
+    int zeroed = 0;
+    for (std::size_t at = bytes.find(needle); at != std::string::npos;
+         at = bytes.find(needle, at + 1)) {
+        std::string damaged = bytes;
+        damaged.replace(at, sizeof scale, std::string(sizeof scale, '\0'));
+        writeFile(file, damaged);
+        writeMatchingManifest(file);
+        ++zeroed;
+        try {
+            (void)readTreeGrids(file);
+        } catch (const BakeError& e) {
+            const std::string why = e.what();
+            EXPECT_NE(why.find(file.string()), std::string::npos) << why;
+            EXPECT_EQ(why.find('\n'), std::string::npos) << why;
+        }
+    }
+    EXPECT_GT(zeroed, 0);
+}
+
 TEST(TreeGridsIo, DamagedBytesWithAMatchingManifestAreRefusedNeverFatal)
 {
     // A file edited elsewhere comes with a manifest that matches its bytes. OpenVDB 10.0.1
