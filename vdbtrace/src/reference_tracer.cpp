@@ -64,6 +64,12 @@ void walkVoxels(const Vec3& o, const Vec3& d, double h, double t0, double t1, Vi
     }
 }
 
+// Whether the grids hold any voxel of the boughs to march through.
+bool hasVolume(const bake::TreeGrids& g)
+{
+    return g.layerOpacity && g.layerOpacity->activeVoxelCount() > 0;
+}
+
 // Calls visit(ijk, ta, tb) for each voxel span of o + t d, t in [0, tMax], in order, through the
 // active parts of the grid `intersector` was made for (voxels of size h).
 template <class Visit>
@@ -314,7 +320,7 @@ Reference::Reference(const TracedScene& scene, const bake::TreeGrids& grids,
       mGrids(grids),
       mPlan(EffectsPlan::from(scene.scene->effects)),
       mSubpixels(std::max(1, options.subpixels)),
-      mHasVolume(grids.layerOpacity && grids.layerOpacity->activeVoxelCount() > 0),
+      mHasVolume(hasVolume(grids)),
       mH(grids.voxelSize_cm)
 {
     if (mHasVolume) mIntersector = std::make_unique<Intersector>(*grids.layerOpacity);
@@ -455,9 +461,7 @@ struct FieldTransmittance::Reader {
 };
 
 FieldTransmittance::FieldTransmittance(const bake::TreeGrids& grids)
-    : mReader(grids.layerOpacity && grids.layerOpacity->activeVoxelCount() > 0
-                  ? std::make_unique<Reader>(grids)
-                  : nullptr)
+    : mReader(hasVolume(grids) ? std::make_unique<Reader>(grids) : nullptr)
 {
 }
 
