@@ -249,6 +249,12 @@ idiff -q -fail 0.01 "$work/g.exr" "$work/g1.exr" >/dev/null 2>&1 && fail "--samp
 idiff -q -fail 1e-3 -failpercent 0.5 -warn 1e-3 -warnpercent 0.5 "$work/g.exr" "$work/gc.exr" >/dev/null 2>&1 \
     || fail "curves and cylinders differ: $(idiff -fail 1e-3 "$work/g.exr" "$work/gc.exr" | tail -3)"
 expect_error "an unknown primitive" 2 "needle-primitive" -- render "$src/scenes/bough.json" --method geometry --out "$work/a.exr" --needle-primitive capsule
+# Flat needle ends draw the end discs the default's open needles pass, and the stats say which.
+"$vdbtrace" render "$src/scenes/bough.json" --method geometry --samples 2 --needle-ends flat --out "$work/gf.exr" --stats "$work/gf.json" -q \
+    || fail "--needle-ends flat failed"
+idiff -q -fail 1e-3 "$work/g.exr" "$work/gf.exr" >/dev/null 2>&1 && fail "--needle-ends flat renders the open needles"
+grep -q '"needle_ends": *"flat"' "$work/gf.json" || fail "the stats do not name the flat ends: $(cat "$work/gf.json")"
+expect_error "unknown needle ends" 2 "needle-ends" -- render "$src/scenes/bough.json" --method geometry --out "$work/a.exr" --needle-ends round
 expect_error "an unknown bark" 2 "bark" -- render "$src/scenes/bough.json" --out "$work/a.exr" --bark wood
 expect_error "an unknown layer correlation" 2 "layer-correlation" -- render "$src/scenes/bough.json" --out "$work/a.exr" --layer-correlation some
 expect_error "another method's option" 2 "sample-seed applies to --method geometry, not multiscale" -- render "$src/scenes/bough.json" --out "$work/a.exr" --sample-seed 3

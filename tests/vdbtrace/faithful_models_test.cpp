@@ -169,9 +169,13 @@ TEST(FaithfulModels, ALoneBoughUnderEveryLight)
     // The long bough side-on, lit from six directions, its needles' light against each level's
     // (the needles' mean over 4 rolls). In diffuse light alone the needles are lit whatever
     // lies between them and the light: level 1, which draws the needles, must then send their
-    // light (needleDiffuse, section 4), and every level's is printed. With self-shadowing
-    // nothing else shades the bough: each level's ratio is the self-shadowing model's error
-    // under that light (the explicit needles' shadow rays against the layer model's
+    // light (needleDiffuse, section 4), and every level's is printed. Measured 1.002-1.008
+    // under three lights, 1.030-1.039 along the branch and from behind (1.039 at 4x the
+    // pixels too, its coverage within 0.1%: level 1's light per unit coverage, not its
+    // strips' ends); bounded at 4.5%. Until the needles' ends were open (render.needle_ends)
+    // the flat ends' light, 6% of the needles' along the branch, hid that excess. With
+    // self-shadowing nothing else shades the bough: each level's ratio is the self-shadowing
+    // model's error under that light (the explicit needles' shadow rays against the layer model's
     // transmittance through the bough), under each layer correlation. Beside the camera the
     // lines of the view and of the light pass the same gaps (the hot spot): "needles" must
     // then agree with the needles within 3% at every level, where "independent" gets 0.84 of
@@ -207,7 +211,7 @@ TEST(FaithfulModels, ALoneBoughUnderEveryLight)
                     "  diffuse alone: level 1 %.3f, level 2 %.3f, level 3 %.3f of the needles\n",
                     light.name, shadowed / lit, l1, level(2, diffuse, light.towards) / lit,
                     level(3, diffuse, light.towards) / lit);
-        EXPECT_NEAR(l1, 1.0, 0.03) << light.name;
+        EXPECT_NEAR(l1, 1.0, 0.045) << light.name;
         for (const char* correlation : {"needles", "independent"}) {
             double ratio[3];
             for (int n = 1; n <= 3; ++n) {
@@ -345,8 +349,8 @@ double referenceLight(const std::string& effects, const char* towards)
 TEST(FaithfulModels, TheReferencesNeedlesAreLitAsTheNeedlesAre)
 {
     // The long bough side-on under four lights, the reference's light against the needles'
-    // (their mean over 4 rolls), in diffuse light alone (within 5%; along the branch, 10%) and
-    // through the bough itself. A needle lies on its cone's layer, so the layers
+    // (their mean over 4 rolls), in diffuse light alone (within 5%) and through the bough
+    // itself (within 5%; along the branch, 8%). A needle lies on its cone's layer, so the layers
     // the light reaching it crosses lie where the line has crossed a whole number of layers
     // from it, on its way out and, where it turns back through the layers past the axis, on
     // its way back: read from points between layers, the reference's self-shadowed needles got
@@ -354,17 +358,18 @@ TEST(FaithfulModels, TheReferencesNeedlesAreLitAsTheNeedlesAre)
     // and the last divided out, 0.980, 0.814, 0.885 and 0.790; with the layers' places kept
     // through the turn, 1.027, 0.861, 1.017 and 0.963; with the view's bands at an unknown
     // phase (its coverage 1.6% over the needles' where it was about 3%), 1.020, 0.827, 1.004
-    // and 0.953 (docs/models.md, "The reference's light"). Along the branch the rest is
-    // unexplained: in diffuse light alone the reference sends 0.927 of the needles' light
-    // there (0.956 when it covered more), levels 2-3 0.956 and 0.945, and self-shadowed the
-    // layer models get 0.81-0.89 (ALoneBoughUnderEveryLight).
+    // and 0.953 (docs/models.md, "The reference's light"). Those were against needles whose
+    // flat ends reflected, 6% of their light along the branch, 3% from behind: against the
+    // needles as the models have them (render.needle_ends "open") the reference gets 1.022,
+    // 0.951, 1.004 and 1.000 self-shadowed, 1.014, 0.983, 1.019 and 1.027 in diffuse light
+    // alone (along the branch 0.927 before).
     struct Light {
         const char* towards;
         double diffuseLeast;  ///< of the reference's light over the needles', diffuse alone
         double least;         ///< of the reference's self-shadowed light over the needles'
     };
     const Light lights[] = {{"[0.3, -1, 0.6]", 0.95, 0.95},
-                            {"[1, 0, 0.3]", 0.90, 0.80},
+                            {"[1, 0, 0.3]", 0.95, 0.92},
                             {"[0, 0, 1]", 0.95, 0.95},
                             {"[0.3, 1, 0.6]", 0.95, 0.95}};
     for (const Light& light : lights) {
@@ -565,10 +570,12 @@ TEST(FaithfulModels, ABoughsShadowIsWhereItsNeedlesCastIt)
     // The needles' luminance of each bough (mean over 4 rolls, 16 spp, each needle's own
     // shadow ray) against each level's. The shadow's error is measured on the light it lets
     // through, as a fraction of the unshadowed bough's: in deep shadow the ratio of two small
-    // numbers says little (measured: within 0.03 of the needles' from the camera's side and
-    // from behind, 0.045 from above; bounded at 0.05). Levels 2-3 shade with the layer
-    // model's expected self-shadowing and are dark against the needles when the light comes
-    // through the bough (measured 0.933 and 0.917 from behind; 0.94 and 0.934 with
+    // numbers says little (measured: within 0.03 of the needles' from the camera's side, 0.045
+    // from above, and from behind 0.034-0.052 too little; bounded at 0.06). From behind the
+    // needles let through 0.501 until their ends were open (render.needle_ends), 0.514 since:
+    // the flat ends' light, at the needles' tips, is a larger share of the lit bough's. Levels 2-3
+    // shade with the layer model's expected self-shadowing and are dark against the needles when
+    // the light comes through the bough (measured 0.933 and 0.917 from behind; 0.94 and 0.934 with
     // layer_correlation "independent", whose disjoint arcs of one cone are not anti-correlated;
     // bounded at 9%). Before each
     // hit's shadow cone stood for where its needles lie (ShadowSamples) and the exact law's
@@ -609,7 +616,7 @@ TEST(FaithfulModels, ABoughsShadowIsWhereItsNeedlesCastIt)
                         towards.c_str(), level, name, up / upper, lo / lower,
                         (lo - lower) / upper, lo / alone, through);
             EXPECT_NEAR(up / upper, 1.0, 0.09) << towards << " level " << level << " " << name;
-            EXPECT_NEAR(lo / alone, through, 0.05) << towards << " level " << level << " " << name;
+            EXPECT_NEAR(lo / alone, through, 0.06) << towards << " level " << level << " " << name;
         }
     }
 }

@@ -260,6 +260,7 @@ struct HandMade {
   "ground": {"type": "none"}, "species": {}, "trees": [], "effects": ["diffuse", "specular"]})",
                                    "hand-made.json");
         scene.render.model = scenes::ModelChoices::paper();
+        scene.render.model.needleEnds = "open";  // the needles as every level models them
         traced = buildTracedScene(scene);
     }
     TracedBough& add(const Vec3& base, const Vec3& axis, double length_cm,
@@ -450,6 +451,79 @@ TEST(GeometryTracer, OneNeedlesMeanRadianceIsEquationOne)
     const double Rs = analytic::needleSpecular(needle, light.towardsLight, V, b.exponent);
     const double measuredRs = specular / coverage / (b.specularWeight * E);
     EXPECT_NEAR(measuredRs / Rs, 1.0, 0.05) << measuredRs << " " << Rs;
+}
+
+// One needle looked at down its axis from above, over a lit ground, the light straight down
+// the axis too: which pixels see its end, and which of the ground's points its end shades.
+struct EndOn {
+    RenderResult image;
+    double endRadius_px;  ///< the needle's radius in pixels, at its near end
+};
+
+EndOn renderEndOn(const char* ends, NeedlePrimitive primitive)
+{
+    // 2.4 cm square at the needle's top end (z = 8, 12 cm from the camera): r = 0.5 cm is
+    // 13 pixels of 64; the ground lies 20 cm below the camera.
+    scenes::Scene scene = scenes::parseScene(R"({"name": "end-on",
+  "camera": {"position": [0, 0, 20], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 11.4,
+             "resolution": [64, 64]},
+  "lights": [{"type": "directional", "direction": [0, 0, 1]}],
+  "ground": {"type": "plane", "albedo": [0.5, 0.5, 0.5]}, "species": {}, "trees": [],
+  "effects": ["diffuse", "shadows"], "render": {"background": [0, 0, 0]}})",
+                                             "end-on.json");
+    scene.render.model.needleEnds = ends;
+    TracedScene traced = buildTracedScene(scene);
+    BoughDescription d;  // one cone of one needle along the axis: aperture 0
+    d.spec.base_cm = Vec3(0.0, 0.0, 2.0);
+    d.spec.tip_cm = Vec3(0.0, 0.0, 2.5);
+    d.spec.needles.cone = analytic::ConeGeometry{0.0, 6.0, 0.5, 1};
+    d.spec.needles.coneSpacing_cm = 0.9;
+    d.spec.needleAlbedo = Vec3(0.3);
+    d.seed = 1;
+    traced.boughs.push_back(makeTracedBough(d, scene.camera.position_cm, traced.lights,
+                                            boughLaw("linear"), *traced.layers));
+    GeometryOptions options;
+    options.samples = 16;
+    options.primitive = primitive;
+    const double pixel_cm = 2.0 * 12.0 * std::tan(11.4 / 2.0 * analytic::kPi / 180.0) / 64.0;
+    return {renderGeometry(traced, options), 0.5 / pixel_cm};
+}
+
+TEST(GeometryTracer, AnOpenNeedleIsItsSideAlone)
+{
+    // Down the axis a flat-capped needle shows its lit end disc, the ground behind it in its
+    // shadow; an open one (render.needle_ends "open", the default) shows nothing there (the
+    // camera's rays enter through its end and leave through its side from inside; its side
+    // faces away from a camera on its axis) and the ground lit through it, its axis along the
+    // light. Both primitives: Embree's native curves tell a side from an end by its normal,
+    // the user cylinders exactly.
+    for (const NeedlePrimitive primitive : {NeedlePrimitive::Curve, NeedlePrimitive::Cylinder}) {
+        const EndOn flat = renderEndOn("flat", primitive);
+        const EndOn open = renderEndOn("open", primitive);
+        ASSERT_GT(flat.endRadius_px, 10.0);
+        // The pixels well inside the end's circle (the needle's far end subtends less: 12
+        // against 18 cm, so every one of them is inside the tube from end to end).
+        double flatLight = 0.0, openLight = 0.0, flatFoliage = 0.0, openFoliage = 0.0;
+        int inside = 0;
+        for (int y = 0; y < 64; ++y) {
+            for (int x = 0; x < 64; ++x) {
+                const double dx = x + 0.5 - 32.0, dy = y + 0.5 - 32.0;
+                if (std::hypot(dx, dy) > 0.5 * flat.endRadius_px) continue;
+                ++inside;
+                const std::size_t i = std::size_t(y) * 64 + std::size_t(x);
+                flatLight += flat.image.image.pixel(x, y)[1];
+                openLight += open.image.image.pixel(x, y)[1];
+                flatFoliage += flat.image.image.aovs.at("foliage")[i];
+                openFoliage += open.image.image.aovs.at("foliage")[i];
+            }
+        }
+        ASSERT_GT(inside, 100);
+        // E = 1 on a surface facing the light: the end disc 0.3 / pi, the ground 0.5 / pi.
+        EXPECT_NEAR(flatFoliage / inside, 1.0, 1e-9);
+        EXPECT_NEAR(flatLight / inside, 0.3 / analytic::kPi, 1e-4);
+        EXPECT_NEAR(openFoliage / inside, 0.0, 1e-9);
+        EXPECT_NEAR(openLight / inside, 0.5 / analytic::kPi, 1e-4);
+    }
 }
 
 }  // namespace

@@ -415,6 +415,13 @@ TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
     expectInputError([&] { buildTracedScene(scene); },
                      "fir.json: render.layer_correlation: unknown layer correlation 'some' "
                      "(known: needles, independent)");
+    EXPECT_EQ(needleEndNames().front(), scenes::ModelChoices{}.needleEnds);
+    EXPECT_EQ(scenes::ModelChoices::paper().needleEnds, "flat");  // the published truth
+    scene.render.model = {};
+    scene.render.model.needleEnds = "round";
+    expectInputError([&] { buildTracedScene(scene); },
+                     "fir.json: render.needle_ends: unknown needle ends 'round' (known: open, "
+                     "flat)");
 }
 
 TEST(MultiscaleTracer, ConeLevelCrossesTheTrueCones)

@@ -1,9 +1,14 @@
 // The explicit-needle ground truth: solid cylinders in an Embree 3 BVH, point samples, shadow
 // rays, and the per-point integrands of the paper's eqs. (1) and (2).
 //
-// A cylinder is what section 4 integrates over and what the multiscale level 1 covers exactly:
-// flat-capped, not RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE's capsule (a hemisphere of radius r at
-// each end adds pi r^2 to the needle's projected area 2 r l, +1.8% for the paper's needle).
+// A needle is what section 4 integrates over: a cylinder's side. Its ends are open by default
+// (render.needle_ends "open"): a line meets a needle where it enters through the side, and
+// passes through its ends, so that a needle covers 2 r l |sin| of the view and reflects from
+// its side alone, as every level models it. With "flat" a needle is the solid flat-capped
+// cylinder (not RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE's capsule, whose hemispheres add pi r^2
+// to the projected area 2 r l, +1.8% for the paper's needle): its end discs, r / 2l of its
+// area, face along the bough, and on a fir's lit side they carry 4% of its light
+// (docs/models.md, "Needle ends"). Branches are always solid.
 // Embree's RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE with equal radii at both ends and no
 // neighbours is that cylinder, intersected natively in single precision (NeedlePrimitive::
 // Curve, the default); its hit is intersected again here in double precision to be shaded.
@@ -50,6 +55,7 @@ struct CylinderSet {
     std::vector<Cylinder> cylinders;
     double pad = 0.0;  // cm added to every box: the float ray Embree walks vs our double ray
     unsigned geomID = RTC_INVALID_GEOMETRY_ID;
+    bool openEnds = false;  // met only through the side (render.needle_ends "open")
 };
 
 // A scatter's variant (scenes::TreePlacement::variantOf) whose trees are instanced: its first
@@ -89,8 +95,9 @@ struct RayContext {
 // The ray's interval inside the solid cylinder: the infinite cylinder's chord intersected with
 // the slab 0 <= (p - base).axis <= l. The chord comes from the closest approach (no
 // cancellation between two large squares when the ray passes far away). `cap`: entered
-// through an end.
-bool intersectCylinder(const Vec3& o, const Vec3& d, const Cylinder& c, double& tIn,
+// through an end. With `openEnds` only a ray entering through the side meets it (tIn is then
+// where it enters; one through an end passes).
+bool intersectCylinder(const Vec3& o, const Vec3& d, const Cylinder& c, bool openEnds, double& tIn,
                        double& tOut, bool& cap)
 {
     const Vec3 u(c.axis);
@@ -122,6 +129,7 @@ bool intersectCylinder(const Vec3& o, const Vec3& d, const Cylinder& c, double& 
     tIn = std::max(c0, s0);
     tOut = std::min(c1, s1);
     cap = s0 > c0;
+    if (openEnds && (cap || !(c0 > -kInf))) return false;  // through an end, or along the axis
     return tIn < tOut;
 }
 
@@ -159,8 +167,8 @@ void cylinderIntersectFn(const RTCIntersectFunctionNArguments* args)
     const auto* set = static_cast<const CylinderSet*>(args->geometryUserPtr);
     double tIn, tOut;
     bool cap;
-    if (!intersectCylinder(ctx->origin, ctx->direction, set->cylinders[args->primID], tIn, tOut,
-                           cap)) {
+    if (!intersectCylinder(ctx->origin, ctx->direction, set->cylinders[args->primID], set->openEnds,
+                           tIn, tOut, cap)) {
         return;
     }
     if (!(tIn > ctx->tMin) || tIn > ctx->tMax || tIn > ctx->t) return;
@@ -188,24 +196,50 @@ void cylinderOccludedFn(const RTCOccludedFunctionNArguments* args)
     const auto* set = static_cast<const CylinderSet*>(args->geometryUserPtr);
     double tIn, tOut;
     bool cap;
-    if (!intersectCylinder(ctx->origin, ctx->direction, set->cylinders[args->primID], tIn, tOut,
-                           cap)) {
+    if (!intersectCylinder(ctx->origin, ctx->direction, set->cylinders[args->primID], set->openEnds,
+                           tIn, tOut, cap)) {
         return;
     }
-    if (tOut > ctx->tMin && tIn < ctx->tMax) {
+    // A solid stops a ray that starts inside it; an open needle one that enters its side.
+    if ((set->openEnds ? tIn : tOut) > ctx->tMin && tIn < ctx->tMax) {
         reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
     }
 }
 
+// Whether Embree's hit i on a native curve is one an open needle has: through its side, from
+// outside (Embree also reports an end disc, and where a ray leaves, when asked again). Its Ng
+// is the solid's outward normal, along the axis on an end; instances only translate.
+bool entersTheSide(const RTCFilterFunctionNArguments* args, unsigned i)
+{
+    const auto* set = static_cast<const CylinderSet*>(args->geometryUserPtr);
+    const glm::vec3 ng(RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
+                       RTCHitN_Ng_z(args->hit, args->N, i));
+    const glm::vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                      RTCRayN_dir_z(args->ray, args->N, i));
+    const glm::vec3 axis = set->cylinders[RTCHitN_primID(args->hit, args->N, i)].axis;
+    return std::abs(glm::dot(ng, axis)) < 0.5f * glm::length(ng) && glm::dot(ng, d) < 0.0f;
+}
+
+// Open needles as native curves: a ray passes their ends.
+void curveIntersectFilterFn(const RTCFilterFunctionNArguments* args)
+{
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] && !entersTheSide(args, i)) args->valid[i] = 0;
+    }
+}
+
 // A shadow ray does not stop at the surface it leaves (a convex cylinder never shadows its own
-// lit side): Embree's native curves ask here.
+// lit side), nor, on open needles, at an end: Embree's native curves ask here.
 void curveOccludedFilterFn(const RTCFilterFunctionNArguments* args)
 {
     const auto* ctx = reinterpret_cast<const RayContext*>(args->context);
+    const bool open = static_cast<const CylinderSet*>(args->geometryUserPtr)->openEnds;
     for (unsigned i = 0; i < args->N; ++i) {
-        if (args->valid[i] && RTCHitN_geomID(args->hit, args->N, i) == ctx->skipGeom &&
-            RTCHitN_primID(args->hit, args->N, i) == ctx->skipPrim &&
-            RTCHitN_instID(args->hit, args->N, i, 0) == ctx->skipInst) {
+        if (!args->valid[i]) continue;
+        if ((RTCHitN_geomID(args->hit, args->N, i) == ctx->skipGeom &&
+             RTCHitN_primID(args->hit, args->N, i) == ctx->skipPrim &&
+             RTCHitN_instID(args->hit, args->N, i, 0) == ctx->skipInst) ||
+            (open && !entersTheSide(args, i))) {
             args->valid[i] = 0;
         }
     }
@@ -331,7 +365,9 @@ private:
             v[3] = v[7] = c.radius;
             indices[i] = unsigned(2 * i);
         }
+        rtcSetGeometryUserData(g, const_cast<CylinderSet*>(&set));
         rtcSetGeometryOccludedFilterFunction(g, curveOccludedFilterFn);
+        if (set.openEnds) rtcSetGeometryIntersectFilterFunction(g, curveIntersectFilterFn);
         rtcCommitGeometry(g);
         const unsigned id = rtcAttachGeometry(scene, g);
         rtcReleaseGeometry(g);
@@ -471,11 +507,15 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     const bool cylinder = ctx.geomID != RTC_INVALID_GEOMETRY_ID;
     int tree = -1;  // an instance's; else the hit's own, below
     const Cylinder c = cylinder ? hitCylinder(ctx, tree) : Cylinder{};
+    const bool instanced = cylinder && ctx.instID != RTC_INVALID_GEOMETRY_ID;
+    const bool isNeedle = cylinder && (instanced || ctx.geomID == mNeedles.geomID);
     if (curve) {
         // A native curve's hit: where the double ray enters that cylinder, or where Embree
         // found it if the double ray only grazes it.
         double tIn, tOut;
-        if (intersectCylinder(ray.origin, ray.direction, c, tIn, tOut, ctx.cap) && tIn > 0.0) {
+        if (intersectCylinder(ray.origin, ray.direction, c, isNeedle && mNeedles.openEnds, tIn,
+                              tOut, ctx.cap) &&
+            tIn > 0.0) {
             ctx.t = tIn;
         } else {
             ctx.t = rh.ray.tfar;
@@ -489,8 +529,6 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     // What the hit is and how it reflects.
     Vec3 N = groundNormal, albedo = mScene.scene->ground.albedo;
     double weight = 0.0, exponent = 1.0;
-    const bool instanced = cylinder && ctx.instID != RTC_INVALID_GEOMETRY_ID;
-    const bool isNeedle = cylinder && (instanced || ctx.geomID == mNeedles.geomID);
     if (cylinder) {
         N = cylinderNormal(c, x, ray.direction, ctx.cap);
         if (isNeedle) {
@@ -564,6 +602,7 @@ std::vector<long long> variantsOf(const TracedScene& scene, NeedlePrimitive prim
             v = static_cast<long long>(instancing.variants.size());
             instancing.variants.emplace_back();
             instancing.variants.back().origin = trees[std::size_t(first)].base_cm;
+            instancing.variants.back().needles.openEnds = scene.openNeedleEnds;
             variant[std::size_t(first)] = v;
         }
         variant[i] = v;
@@ -600,6 +639,7 @@ void layOut(const TracedScene& scene, const std::vector<long long>& variant,
         count += std::size_t(layout.lastCone() + 1) * layout.needlesPerCone();
     }
     needles.cylinders.reserve(count);
+    needles.openEnds = scene.openNeedleEnds;
     for (std::size_t k = 0; k < scene.boughs.size(); ++k) {
         const TracedBough& b = scene.boughs[k];
         const NeedleLayout layout(b);

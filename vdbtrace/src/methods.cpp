@@ -55,9 +55,10 @@ RenderResult geometry(const TracedScene& scene, const MethodSettings& s,
     return renderGeometry(scene, s.geometry, options);
 }
 
-nlohmann::json describeGeometry(const scenes::Scene&, const MethodSettings& s)
+nlohmann::json describeGeometry(const scenes::Scene& scene, const MethodSettings& s)
 {
     return {{"samples_per_pixel", s.geometry.samples},
+            {"needle_ends", scene.render.model.needleEnds},
             {"needle_primitive",
              s.geometry.primitive == NeedlePrimitive::Curve ? "curve" : "cylinder"}};
 }

@@ -476,11 +476,23 @@ const Registry<const bool>& barks()
     return solid;
 }
 
+// render.needle_ends: whether the explicit needles' ends are open (the needle its side alone).
+const Registry<const bool>& needleEnds()
+{
+    static const Registry<const bool> open = namedSwitch("needle ends", "open", "flat");
+    return open;
+}
+
 }  // namespace
 
 std::vector<std::string> shadowOriginNames() { return shadowOrigins().names(); }
 
 std::vector<std::string> barkNames() { return barks().names(); }
+
+std::vector<std::string> needleEndNames()
+{
+    return needleEnds().names();
+}
 
 PrimitiveCylinder primitiveCylinder(const TracedScene& scene, std::size_t primitive)
 {
@@ -576,12 +588,15 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     const ShadowOrigin origin =
         chosen("shadow_origin", [&] { return shadowOrigins().get(model.shadowOrigin); });
     const bool solidBark = chosen("bark", [&] { return barks().get(model.bark); });
+    const bool openNeedleEnds =
+        chosen("needle_ends", [&] { return needleEnds().get(model.needleEnds); });
     const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
     TracedScene out;
     out.scene = &scene;
     out.layers = &layers;
     out.boughLaw = law;
     out.shadowOrigin = origin;
+    out.openNeedleEnds = openNeedleEnds;
     out.lights = unifiedLights(scene);
     out.trees.resize(scene.trees.size());
     // A scatter's variant is grown once, at its first tree. A copy's boughs and branches are

@@ -96,7 +96,8 @@ private:
 // it): --paper first, then each law named.
 struct ModelOverrides {
     bool paper = false;
-    std::string boughLaw, layerModel, extinctionLaw, shadowOrigin, bark, layerCorrelation;
+    std::string boughLaw, layerModel, extinctionLaw, shadowOrigin, bark, layerCorrelation,
+        needleEnds;
     double levelBlend = 0.0;    ///< 0: the scene's
     double coneLevelMax = 0.0;  ///< 0: the scene's
 
@@ -106,7 +107,7 @@ struct ModelOverrides {
                      "Every approximation as the paper prints it (render.preset \"paper\"): "
                      "bough law linear, layer model paper, extinction law layer, shadow origin "
                      "axis, no level blend, bark line, level 3 from q = 1, layer correlation "
-                     "independent");
+                     "independent, needle ends flat");
         cmd.add_option("--bough-law", boughLaw, "multiscale level 3's law (render.bough_law)")
             ->check(CLI::IsMember(vdbtrace::boughLawNames()));
         cmd.add_option("--layer-model", layerModel,
@@ -134,6 +135,11 @@ struct ModelOverrides {
                        "and the light's lines through one cone meet the same needles: the hot "
                        "spot) or independent (the paper's; render.layer_correlation)")
             ->check(CLI::IsMember(vdbtrace::layerCorrelationNames()));
+        cmd.add_option("--needle-ends", needleEnds,
+                       "geometry: the explicit needles' ends; open (a needle is its side, as "
+                       "section 4 shades it and every level models it) or flat (solid "
+                       "flat-capped cylinders, whose end discs reflect; render.needle_ends)")
+            ->check(CLI::IsMember(vdbtrace::needleEndNames()));
         cmd.add_option("--cone-level-max", coneLevelMax,
                        "multiscale: level 3 (the bough a volume) from this footprint over cone "
                        "spacing q on, level 2 below; the paper's 1 (render.cone_level_max)")
@@ -152,6 +158,7 @@ struct ModelOverrides {
         if (levelBlend > 0.0) m.levelBlend = levelBlend;
         if (!bark.empty()) m.bark = bark;
         if (!layerCorrelation.empty()) m.layerCorrelation = layerCorrelation;
+        if (!needleEnds.empty()) m.needleEnds = needleEnds;
         if (coneLevelMax > 0.0) m.coneLevelMax = coneLevelMax;
         if (!(m.coneLevelMax > render.needleLevelMax)) {
             std::ostringstream message;
@@ -342,6 +349,7 @@ std::string frameJobDigest(const fs::path& sceneFile, const std::string& methodN
         {"shadow_origin", model.shadowOrigin},
         {"bark", model.bark},
         {"layer_correlation", model.layerCorrelation},
+        {"needle_ends", model.needleEnds},
         {"level_blend", model.levelBlend},
         {"cone_level_max", model.coneLevelMax},
         {"resolution", {frame.width, frame.height}},

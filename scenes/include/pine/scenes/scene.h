@@ -105,10 +105,15 @@ struct ModelChoices {
     /// light through one cone meet its same evenly spaced needles: the hot spot) or
     /// "independent" (every crossing on its own, section 6).
     std::string layerCorrelation = "needles";
+    /// The explicit needles' ends (the geometry method's ground truth): "open" (a needle is
+    /// its side, as section 4 shades it and every level models it) or "flat" (a solid
+    /// cylinder whose end discs reflect and stop light: the ground truth until 2026-12-07,
+    /// kept by the paper preset so that its published images stay reproducible).
+    std::string needleEnds = "open";
     /// Every choice as the paper prints it (preset "paper"): today's published behaviour.
     static ModelChoices paper()
     {
-        return {"linear", "paper", "layer", "axis", 1.0, "line", 1.0, "independent"};
+        return {"linear", "paper", "layer", "axis", 1.0, "line", 1.0, "independent", "flat"};
     }
     /// The choices that agree with the explicit needles (preset "faithful", the default).
     static ModelChoices faithful() { return {}; }
@@ -117,7 +122,7 @@ struct ModelChoices {
 struct RenderSettings {
     Vec3 background{0.55, 0.7, 0.9};
     /// preset, then bough_law, layer_model, extinction_law, shadow_origin, level_blend, bark,
-    /// cone_level_max, layer_correlation
+    /// cone_level_max, layer_correlation, needle_ends
     ModelChoices model;
     /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
     /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):

@@ -195,6 +195,9 @@ struct TracedScene {
     std::shared_ptr<const BoughLawContext> lawContext;
     /// render.shadow_origin: where a bough hit's shadow stands for.
     ShadowOrigin shadowOrigin = ShadowOrigin::Needles;
+    /// render.needle_ends: whether the explicit needles are their sides alone ("open", what
+    /// section 4 shades and every level models) or solid flat-capped cylinders ("flat").
+    bool openNeedleEnds = true;
 
     /// Made with bvh (indexPrimitives): see columns().
     std::shared_ptr<LightColumnsSet> lightColumns;
@@ -235,6 +238,9 @@ std::vector<std::string> shadowOriginNames();
 
 /// The values of render.bark, the faithful one first.
 std::vector<std::string> barkNames();
+
+/// The values of render.needle_ends, the faithful one first.
+std::vector<std::string> needleEndNames();
 
 /// What a method needs of the traced scene beyond its branches and boughs (each method says,
 /// RenderMethod::parts). The geometry method walks an Embree BVH of its own and never
