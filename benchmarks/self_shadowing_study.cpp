@@ -1,12 +1,13 @@
 // A study, not a test: the layer model's self-shadowing (section 6, errata E13) against shadow
 // rays through the explicit needles, point by point. One long paper bough side-on, as
 // FaithfulModels.ALoneBoughUnderEveryLight renders it, but without rendering: points on the
-// needles' surfaces, each weighted by the Lambertian light it sends to the camera (n . L times
-// n . V, zero unless both are positive) when a ray towards the camera leaves it through the
-// other needles; each then gets the needles' answer (a ray towards the light through every
-// other needle, hit or not) and the model's (LayerModel::transmittance from the needle's axis
-// point, as level 1 shades it). Their weighted means reproduce that test's needles and level
-// 1 within about 1% in seconds, and split the model's error by the distance from the branch.
+// needles' sides (the ground truth's needles have open ends: render.needle_ends), each weighted by
+// the Lambertian light it sends to the camera (n . L times n . V, zero unless both are positive)
+// when a ray towards the camera leaves it through the other needles; each then gets the needles'
+// answer (a ray towards the light through every other needle, hit or not) and the model's
+// (LayerModel::transmittance from the needle's axis point, as level 1 shades it). Their weighted
+// means reproduce that test's needles and level 1 within about 1% in seconds, and split the model's
+// error by the distance from the branch.
 //
 //   self_shadowing_study [--light X Y Z] [--correlation needles|independent] [--points N]
 //
@@ -87,15 +88,21 @@ int main(int argc, char** argv)
                    1;
         };
         const long lightWindow = window(L), viewWindow = window(V);
-        const auto blocked = [&](const Vec3& x, const Vec3& D, long w, long j, int i) {
+        // As the ground truth draws them (render.needle_ends "open"): a shadow ray stops where
+        // it enters a needle's side; a point inside another needle is hidden from the camera,
+        // whose ray entered that needle first.
+        const auto blocked = [&](const Vec3& x, const Vec3& D, long w, long j, int i,
+                                 bool towardsLight) {
             for (long jj = std::max(0L, j - w); jj <= std::min(needles.lastCone(), j + w); ++jj) {
                 const Vec3 apex = needles.apex(jj);
                 for (int ii = 0; ii < N; ++ii) {
                     if (jj == j && ii == i) continue;
                     const Vec3 tip = apex + l * needles.direction(needles.azimuth(jj, ii));
+                    const ConeRay ray{x, D, 0.0};
                     double tIn, tOut;
-                    if (intersectCylinder(ConeRay{x, D, 0.0}, apex, tip, r, tIn, tOut) &&
-                        tOut > 0.0) {
+                    if (towardsLight
+                            ? entersCylinderSide(ray, apex, tip, r, tIn)
+                            : intersectCylinder(ray, apex, tip, r, tIn, tOut) && tOut > 0.0) {
                         return true;
                     }
                 }
@@ -118,13 +125,13 @@ int main(int argc, char** argv)
             const double lit = glm::dot(normal, L), seen = glm::dot(normal, V);
             if (lit <= 0.0 || seen <= 0.0) continue;
             const Vec3 x = onAxis + (r * 1.0001) * normal;
-            if (blocked(x, V, viewWindow, j, i)) continue;
+            if (blocked(x, V, viewWindow, j, i, false)) continue;
             const double w = lit * seen;
             const Vec3 off = onAxis - b.base_cm;
             const double rho = glm::length(off - glm::dot(off, b.axis) * b.axis);
             const int bin = std::clamp(int(rho / reach * kBins), 0, kBins - 1);
             weight[bin] += w;
-            rays[bin] += blocked(x, L, lightWindow, j, i) ? 0.0 : w;
+            rays[bin] += blocked(x, L, lightWindow, j, i, true) ? 0.0 : w;
             model[bin] += w * layers.transmittance(b, onAxis, L, j, V);
         }
         std::printf(

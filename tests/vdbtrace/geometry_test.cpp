@@ -65,6 +65,31 @@ TEST(Geometry, CylinderIntervalMatchesTheChord)
     EXPECT_FALSE(intersectCylinder(aboveCap, a, b, 1.0, tIn, tOut));
 }
 
+TEST(Geometry, AnOpenCylinderIsEnteredThroughItsSideOnly)
+{
+    // The solid's entry where it is through the side; a ray through an end (down the axis, or
+    // obliquely through an end and out through the side) meets no open cylinder, nor one that
+    // starts inside it.
+    const Vec3 a(0, 0, -5), b(0, 0, 5);
+    double t = 0.0, tIn, tOut;
+    for (const Vec3& d : {Vec3(1, 0, 0), glm::normalize(Vec3(1, 0.2, 0.5))}) {
+        const ConeRay side{Vec3(0.3, 0.1, 1.0) - 10.0 * d, d, 0.0};
+        ASSERT_TRUE(entersCylinderSide(side, a, b, 1.0, t));
+        ASSERT_TRUE(intersectCylinder(side, a, b, 1.0, tIn, tOut));
+        EXPECT_NEAR(t, tIn, 1e-12);
+    }
+    const ConeRay down{Vec3(0.2, 0, 20), Vec3(0, 0, -1), 0.0};
+    EXPECT_TRUE(intersectCylinder(down, a, b, 1.0, tIn, tOut));
+    EXPECT_FALSE(entersCylinderSide(down, a, b, 1.0, t));
+    const Vec3 slant = glm::normalize(Vec3(0.3, 0, -1));  // in at the top, out through the side
+    const ConeRay endThenSide{Vec3(0, 0, 5) - 2.0 * slant, slant, 0.0};
+    EXPECT_TRUE(intersectCylinder(endThenSide, a, b, 1.0, tIn, tOut));
+    EXPECT_FALSE(entersCylinderSide(endThenSide, a, b, 1.0, t));
+    const ConeRay inside{Vec3(0, 0, 0), Vec3(1, 0, 0), 0.0};
+    EXPECT_TRUE(intersectCylinder(inside, a, b, 1.0, tIn, tOut));
+    EXPECT_FALSE(entersCylinderSide(inside, a, b, 1.0, t));
+}
+
 TEST(Geometry, StripCoverageIsTheOverlapFraction)
 {
     EXPECT_DOUBLE_EQ(stripCoverage(0.0, 0.1, 1.0), 0.2);    // thin strip inside the footprint

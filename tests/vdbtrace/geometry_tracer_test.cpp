@@ -39,9 +39,11 @@ bake::BakeSettings paperBake(double voxel_cm)
 using test::firScene;
 
 RenderResult renderJson(const std::string& json, int samples, unsigned seed = 0,
-                        NeedlePrimitive primitive = NeedlePrimitive::Curve)
+                        NeedlePrimitive primitive = NeedlePrimitive::Curve,
+                        const char* needleEnds = "open")
 {
-    const scenes::Scene scene = scenes::parseScene(json, "test.json");
+    scenes::Scene scene = scenes::parseScene(json, "test.json");
+    scene.render.model.needleEnds = needleEnds;
     const TracedScene traced = buildTracedScene(scene);
     GeometryOptions options;
     options.samples = samples;
@@ -107,31 +109,35 @@ double meanOf(const std::vector<float>& values, std::size_t offset, std::size_t 
     return sum / double(values.size() / stride);
 }
 
-// Embree's native cone curves stand for the same flat-capped cylinders as the double-precision
-// user geometry: the same samples hit the same needles but for rounding, far below what
-// another sample pattern changes, and cover what they cover (a capsule, RTC_GEOMETRY_TYPE_
-// ROUND_LINEAR_CURVE, would add pi r^2 to each needle's 2 r l: +1.8% on this fir's needles).
+// Embree's native cone curves stand for the same cylinders as the double-precision user
+// geometry, open-ended (their ends passed by Embree's normals) or flat-capped: the same
+// samples hit the same needles but for rounding, far below what another sample pattern
+// changes, and cover what they cover (a capsule, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE, would
+// add pi r^2 to each needle's 2 r l: +1.8% on this fir's needles).
 TEST(GeometryTracer, NativeCurvesAreTheSameCylinders)
 {
     const std::string json = firScene(R"("diffuse", "specular", "shadows")", 96, 72);
-    const RenderResult curve = renderJson(json, 4, 0, NeedlePrimitive::Curve);
-    const RenderResult cylinder = renderJson(json, 4, 0, NeedlePrimitive::Cylinder);
-    const RenderResult otherSamples = renderJson(json, 4, 1, NeedlePrimitive::Cylinder);
-    const auto near = [](std::uint64_t a, std::uint64_t b) {
-        return std::abs(double(a) - double(b)) <= 1e-3 * double(b) + 2.0;
-    };
-    EXPECT_TRUE(near(curve.stats.needleHits, cylinder.stats.needleHits))
-        << curve.stats.needleHits << " " << cylinder.stats.needleHits;
-    EXPECT_TRUE(near(curve.stats.branchHits, cylinder.stats.branchHits))
-        << curve.stats.branchHits << " " << cylinder.stats.branchHits;
-    EXPECT_TRUE(near(curve.stats.shadowRays, cylinder.stats.shadowRays));
-    const double foliage = meanOf(cylinder.image.aovs.at("foliage"), 0, 1);
-    ASSERT_GT(foliage, 0.02);
-    EXPECT_NEAR(meanOf(curve.image.aovs.at("foliage"), 0, 1) / foliage, 1.0, 2e-3);
-    EXPECT_NEAR(meanOf(curve.image.rgba, 3, 4), meanOf(cylinder.image.rgba, 3, 4), 1e-3);
-    const double rounding = rmse(curve.image, cylinder.image);
-    const double sampling = rmse(otherSamples.image, cylinder.image);
-    EXPECT_LT(rounding, 0.05 * sampling) << rounding << " against " << sampling;
+    for (const char* ends : {"open", "flat"}) {
+        SCOPED_TRACE(ends);
+        const RenderResult curve = renderJson(json, 4, 0, NeedlePrimitive::Curve, ends);
+        const RenderResult cylinder = renderJson(json, 4, 0, NeedlePrimitive::Cylinder, ends);
+        const RenderResult otherSamples = renderJson(json, 4, 1, NeedlePrimitive::Cylinder, ends);
+        const auto near = [](std::uint64_t a, std::uint64_t b) {
+            return std::abs(double(a) - double(b)) <= 1e-3 * double(b) + 2.0;
+        };
+        EXPECT_TRUE(near(curve.stats.needleHits, cylinder.stats.needleHits))
+            << curve.stats.needleHits << " " << cylinder.stats.needleHits;
+        EXPECT_TRUE(near(curve.stats.branchHits, cylinder.stats.branchHits))
+            << curve.stats.branchHits << " " << cylinder.stats.branchHits;
+        EXPECT_TRUE(near(curve.stats.shadowRays, cylinder.stats.shadowRays));
+        const double foliage = meanOf(cylinder.image.aovs.at("foliage"), 0, 1);
+        ASSERT_GT(foliage, 0.02);
+        EXPECT_NEAR(meanOf(curve.image.aovs.at("foliage"), 0, 1) / foliage, 1.0, 2e-3);
+        EXPECT_NEAR(meanOf(curve.image.rgba, 3, 4), meanOf(cylinder.image.rgba, 3, 4), 1e-3);
+        const double rounding = rmse(curve.image, cylinder.image);
+        const double sampling = rmse(otherSamples.image, cylinder.image);
+        EXPECT_LT(rounding, 0.05 * sampling) << rounding << " against " << sampling;
+    }
 }
 
 TEST(GeometryTracer, AVariantsTreesAreItsFirstTreeMoved)
@@ -313,8 +319,8 @@ TEST(GeometryTracer, CoversWhatTheMultiscaleNeedleLevelCovers)
     // needles wherever the pixel's axis passes a cone (cone_crossings.h's bands), also along
     // its silhouette where the axis does not cross it (looking only at crossings lost up to
     // 1/N there, 4-10% over seeds). The rest, both ways, stays under 4%: needle ends
-    // (the strip runs on by up to half a footprint w: w / (l s_v) ~ 0.2 / 8 cm), caps the
-    // strip has not (pi r^2 / (2 r l) < 2%, only end-on), and overlaps (level 1 composites
+    // (the strip runs on by up to half a footprint w: w / (l s_v) ~ 0.2 / 8 cm), and overlaps
+    // (the needles' ends are open, as the strip has them; level 1 composites
     // a pixel's needles as independent, 1 - prod(1 - c_i); the geometry's union is exact).
     // 64 samples leave a sampling error of the total well under 1%.
     const analytic::ConeGeometry cone{analytic::kPi / 8, 4.25, 0.05, 12};
@@ -492,37 +498,41 @@ EndOn renderEndOn(const char* ends, NeedlePrimitive primitive)
 TEST(GeometryTracer, AnOpenNeedleIsItsSideAlone)
 {
     // Down the axis a flat-capped needle shows its lit end disc, the ground behind it in its
-    // shadow; an open one (render.needle_ends "open", the default) shows nothing there (the
-    // camera's rays enter through its end and leave through its side from inside; its side
+    // shadow; an open one (render.needle_ends "open", the default) shows nothing (its side
     // faces away from a camera on its axis) and the ground lit through it, its axis along the
-    // light. Both primitives: Embree's native curves tell a side from an end by its normal,
-    // the user cylinders exactly.
+    // light. Near the axis the camera's rays leave through the far end; in a ring further out
+    // (0.7 to 0.92 of the near end's radius) they leave through the side, from inside, and
+    // reach ground outside the needle's shadow. Both primitives: Embree's native curves tell
+    // a side from an end, and an entry from an exit, by its normal; the user cylinders
+    // exactly.
     for (const NeedlePrimitive primitive : {NeedlePrimitive::Curve, NeedlePrimitive::Cylinder}) {
         const EndOn flat = renderEndOn("flat", primitive);
         const EndOn open = renderEndOn("open", primitive);
         ASSERT_GT(flat.endRadius_px, 10.0);
-        // The pixels well inside the end's circle (the needle's far end subtends less: 12
-        // against 18 cm, so every one of them is inside the tube from end to end).
-        double flatLight = 0.0, openLight = 0.0, flatFoliage = 0.0, openFoliage = 0.0;
-        int inside = 0;
-        for (int y = 0; y < 64; ++y) {
-            for (int x = 0; x < 64; ++x) {
-                const double dx = x + 0.5 - 32.0, dy = y + 0.5 - 32.0;
-                if (std::hypot(dx, dy) > 0.5 * flat.endRadius_px) continue;
-                ++inside;
-                const std::size_t i = std::size_t(y) * 64 + std::size_t(x);
-                flatLight += flat.image.image.pixel(x, y)[1];
-                openLight += open.image.image.pixel(x, y)[1];
-                flatFoliage += flat.image.image.aovs.at("foliage")[i];
-                openFoliage += open.image.image.aovs.at("foliage")[i];
+        // Pixels whose centres lie within [from, to] of the near end's radius (a pixel's
+        // samples within 0.71 pixel of its centre, 0.027 cm at the near end).
+        for (const auto& [from, to] : {std::pair{0.0, 0.5}, std::pair{0.7, 0.92}}) {
+            double flatLight = 0.0, openLight = 0.0, flatFoliage = 0.0, openFoliage = 0.0;
+            int pixels = 0;
+            for (int y = 0; y < 64; ++y) {
+                for (int x = 0; x < 64; ++x) {
+                    const double rho = std::hypot(x + 0.5 - 32.0, y + 0.5 - 32.0);
+                    if (rho < from * flat.endRadius_px || rho > to * flat.endRadius_px) continue;
+                    ++pixels;
+                    const std::size_t i = std::size_t(y) * 64 + std::size_t(x);
+                    flatLight += flat.image.image.pixel(x, y)[1];
+                    openLight += open.image.image.pixel(x, y)[1];
+                    flatFoliage += flat.image.image.aovs.at("foliage")[i];
+                    openFoliage += open.image.image.aovs.at("foliage")[i];
+                }
             }
+            ASSERT_GT(pixels, 100) << from;
+            // E = 1 on a surface facing the light: the end disc 0.3 / pi, the ground 0.5 / pi.
+            EXPECT_NEAR(flatFoliage / pixels, 1.0, 1e-9) << from;
+            EXPECT_NEAR(flatLight / pixels, 0.3 / analytic::kPi, 1e-4) << from;
+            EXPECT_NEAR(openFoliage / pixels, 0.0, 1e-9) << from;
+            EXPECT_NEAR(openLight / pixels, 0.5 / analytic::kPi, 1e-4) << from;
         }
-        ASSERT_GT(inside, 100);
-        // E = 1 on a surface facing the light: the end disc 0.3 / pi, the ground 0.5 / pi.
-        EXPECT_NEAR(flatFoliage / inside, 1.0, 1e-9);
-        EXPECT_NEAR(flatLight / inside, 0.3 / analytic::kPi, 1e-4);
-        EXPECT_NEAR(openFoliage / inside, 0.0, 1e-9);
-        EXPECT_NEAR(openLight / inside, 0.5 / analytic::kPi, 1e-4);
     }
 }
 

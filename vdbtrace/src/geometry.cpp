@@ -76,4 +76,26 @@ bool intersectCylinder(const ConeRay& ray, const Vec3& a, const Vec3& b, double 
     return true;
 }
 
+bool entersCylinderSide(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius, double& t)
+{
+    const Vec3 axis = b - a;
+    const double length = glm::length(axis);
+    if (!(length > 0.0) || !(radius > 0.0)) return false;
+    const Vec3 u = axis / length;
+    const Vec3 m = ray.origin - a;
+    const Vec3 dp = ray.direction - glm::dot(ray.direction, u) * u;
+    const Vec3 mp = m - glm::dot(m, u) * u;
+    const double A = glm::dot(dp, dp), B = 2.0 * glm::dot(dp, mp),
+                 C = glm::dot(mp, mp) - radius * radius;
+    if (!(A > 1e-300)) return false;  // along the axis: never through the side
+    const double disc = B * B - 4.0 * A * C;
+    if (disc < 0.0) return false;
+    const double t0 = (-B - std::sqrt(disc)) / (2.0 * A);  // into the infinite cylinder
+    if (t0 < 0.0) return false;
+    const double s = glm::dot(m, u) + t0 * glm::dot(ray.direction, u);
+    if (s < 0.0 || s > length) return false;
+    t = t0;
+    return true;
+}
+
 }  // namespace pine::vdbtrace

@@ -90,4 +90,9 @@ inline float roundedUp(double x)
 bool intersectCylinder(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius,
                        double& tIn, double& tOut);
 
+/// Where the ray, from its origin on, enters the same cylinder through its side (t >= 0):
+/// false if it meets only an end, or nothing. A needle with open ends (render.needle_ends
+/// "open", the ground truth's) stops just such a ray.
+bool entersCylinderSide(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius, double& t);
+
 }  // namespace pine::vdbtrace
