@@ -35,19 +35,39 @@ bool closestPassage(const ConeRay& ray, const Vec3& a, const Vec3& b, Passage& o
     return true;
 }
 
+namespace {
+
+// The ray against the infinite cylinder about segment a-b, |(o + t d - a) x u| = r, as
+// A t^2 + B t + C = 0; m = o - a. False for a segment or radius of no size.
+struct AboutAxis {
+    Vec3 u, m;
+    double length, A, B, C;
+};
+
+bool aboutAxis(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius, AboutAxis& q)
+{
+    const Vec3 axis = b - a;
+    q.length = glm::length(axis);
+    if (!(q.length > 0.0) || !(radius > 0.0)) return false;
+    q.u = axis / q.length;
+    q.m = ray.origin - a;
+    const Vec3 dp = ray.direction - glm::dot(ray.direction, q.u) * q.u;
+    const Vec3 mp = q.m - glm::dot(q.m, q.u) * q.u;
+    q.A = glm::dot(dp, dp);
+    q.B = 2.0 * glm::dot(dp, mp);
+    q.C = glm::dot(mp, mp) - radius * radius;
+    return true;
+}
+
+}  // namespace
+
 bool intersectCylinder(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius,
                        double& tIn, double& tOut)
 {
-    const Vec3 axis = b - a;
-    const double length = glm::length(axis);
-    if (!(length > 0.0) || !(radius > 0.0)) return false;
-    const Vec3 u = axis / length;
-    // Infinite cylinder: |(o + t d - a) x u| = r.
-    const Vec3 m = ray.origin - a;
-    const Vec3 dp = ray.direction - glm::dot(ray.direction, u) * u;
-    const Vec3 mp = m - glm::dot(m, u) * u;
-    const double A = glm::dot(dp, dp), B = 2.0 * glm::dot(dp, mp),
-                 C = glm::dot(mp, mp) - radius * radius;
+    AboutAxis c;
+    if (!aboutAxis(ray, a, b, radius, c)) return false;
+    const Vec3 &u = c.u, &m = c.m;
+    const double length = c.length, A = c.A, B = c.B, C = c.C;
     double t0 = -std::numeric_limits<double>::infinity(),
            t1 = std::numeric_limits<double>::infinity();
     if (A > 1e-300) {
@@ -78,22 +98,15 @@ bool intersectCylinder(const ConeRay& ray, const Vec3& a, const Vec3& b, double 
 
 bool entersCylinderSide(const ConeRay& ray, const Vec3& a, const Vec3& b, double radius, double& t)
 {
-    const Vec3 axis = b - a;
-    const double length = glm::length(axis);
-    if (!(length > 0.0) || !(radius > 0.0)) return false;
-    const Vec3 u = axis / length;
-    const Vec3 m = ray.origin - a;
-    const Vec3 dp = ray.direction - glm::dot(ray.direction, u) * u;
-    const Vec3 mp = m - glm::dot(m, u) * u;
-    const double A = glm::dot(dp, dp), B = 2.0 * glm::dot(dp, mp),
-                 C = glm::dot(mp, mp) - radius * radius;
-    if (!(A > 1e-300)) return false;  // along the axis: never through the side
-    const double disc = B * B - 4.0 * A * C;
+    AboutAxis q;
+    if (!aboutAxis(ray, a, b, radius, q)) return false;
+    if (!(q.A > 1e-300)) return false;  // along the axis: never through the side
+    const double disc = q.B * q.B - 4.0 * q.A * q.C;
     if (disc < 0.0) return false;
-    const double t0 = (-B - std::sqrt(disc)) / (2.0 * A);  // into the infinite cylinder
+    const double t0 = (-q.B - std::sqrt(disc)) / (2.0 * q.A);  // into the infinite cylinder
     if (t0 < 0.0) return false;
-    const double s = glm::dot(m, u) + t0 * glm::dot(ray.direction, u);
-    if (s < 0.0 || s > length) return false;
+    const double s = glm::dot(q.m, q.u) + t0 * glm::dot(ray.direction, q.u);
+    if (s < 0.0 || s > q.length) return false;
     t = t0;
     return true;
 }
