@@ -513,7 +513,7 @@ void GeometryRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
         // A native curve's hit: where the double ray enters that cylinder, or where Embree
         // found it if the double ray only grazes it.
         double tIn, tOut;
-        if (intersectCylinder(ray.origin, ray.direction, c, isNeedle && mNeedles.openEnds, tIn,
+        if (intersectCylinder(ray.origin, ray.direction, c, isNeedle && mScene.openNeedleEnds, tIn,
                               tOut, ctx.cap) &&
             tIn > 0.0) {
             ctx.t = tIn;
