@@ -221,6 +221,29 @@ for r in j["trees"]:
     assert abs(r["coverage_bias"] - (ca / cb - 1)) < 1e-12, r
     assert abs(r["luminance_bias"] - ((la / ca) / (lb / cb) - 1)) < 1e-12, r
 PY2
+# A render box-filtered to the truth's pixels after it was written (scripts/forest_levels.sh)
+# keeps the sums of its own pixels: diff reads them in the resized image's, by the frame its
+# header names (they had read 4 times the coverage here, 16 times at a quarter's footprints).
+"$vdbtrace" render "$src/scenes/bough.json" --resolution 1280x960 --out "$work/b2.exr" 2>/dev/null \
+    || fail "a 1280x960 render of bough.json failed"
+exr_info "$work/b2.exr" | grep -q "pine:tree_foliage_frame: \"1280x960\"" \
+    || fail "the render's header does not name the frame of its sums"
+oiiotool "$work/b2.exr" --resize:filter=box 640x480 -o "$work/b2s.exr" || fail "oiiotool --resize failed"
+"$vdbtrace" diff "$work/b2s.exr" "$work/g.exr" --out "$work/b2d" 2>/dev/null || fail "diff of a resized render failed"
+{ exr_info "$work/b2s.exr"; echo "--- same"; cat "$work/bd/errors.json"; } >"$work/both"
+/usr/bin/python3 - "$work/both" "$work/b2d/errors.json" <<'PY2' || fail "diff read a resized render's sums in the pixels it was rendered with"
+import json, re, sys
+header, native = open(sys.argv[1]).read().split("--- same")
+rows = json.loads(json.loads(re.search(r'pine:tree_foliage: (".*")', header).group(1)))
+coverage = {t: c / 4 for t, c, l in rows}
+native = {r["tree"]: r for r in json.loads(native)["trees"]}
+j = json.load(open(sys.argv[2]))
+assert j["trees"], j
+for r in j["trees"]:
+    assert abs(r["coverage"] - coverage[r["tree"]]) <= 1e-9 * coverage[r["tree"]], r
+    # The same bough at half the footprint: its coverage bias as at the scene's own pixels.
+    assert abs(r["coverage_bias"] - native[r["tree"]]["coverage_bias"]) < 0.05, (r, native)
+PY2
 # diff: no folder named; an image in the folder as error.exr; a refused pair makes no folder.
 expect_error "diff into no folder" 2 "--out: no folder named" -- diff "$work/b.exr" "$work/g.exr" --out ''
 mkdir "$work/din" && cp "$work/b.exr" "$work/din/error.exr"

@@ -345,6 +345,49 @@ TEST(TreeFoliage, SumsRoundTripThroughAnExrHeader)
     EXPECT_THROW(treeFoliageOf(Metadata{{kTreeFoliageAttribute, 3}}, "x"), ImageError);
 }
 
+TEST(TreeFoliage, SumsAreReadInThePixelsOfTheImageThatCarriesThem)
+{
+    // Summed at 1280 x 960, the image box-filtered to 320 x 240 (as scripts/forest_levels.sh
+    // does): a pixel of it holds 16 of the frame's.
+    const std::vector<TreeFoliageSum> sums{{0, 1600.0, 480.0}, {3, 32.0, 8.0}};
+    const Metadata header{{kTreeFoliageAttribute, treeFoliageText(sums)},
+                          {kTreeFoliageFrameAttribute, frameText(1280, 960)}};
+    const Image small(320, 240);
+    const auto scaled = treeFoliageOf(header, "fine.exr", &small);
+    ASSERT_TRUE(scaled.has_value());
+    ASSERT_EQ(scaled->size(), sums.size());
+    for (std::size_t i = 0; i < sums.size(); ++i) {
+        EXPECT_EQ((*scaled)[i].tree, sums[i].tree);
+        EXPECT_DOUBLE_EQ((*scaled)[i].coverage_px, sums[i].coverage_px / 16.0);
+        // The mean luminance, what a tree's bias compares, is unchanged.
+        EXPECT_DOUBLE_EQ((*scaled)[i].luminance / (*scaled)[i].coverage_px,
+                         sums[i].luminance / sums[i].coverage_px);
+    }
+    // The frame it was rendered in, a crop of it, or no image: as summed.
+    Image crop(100, 50);
+    crop.frameWidth = 1280;
+    crop.frameHeight = 960;
+    EXPECT_EQ(*treeFoliageOf(header, "crop.exr", &crop), sums);
+    const Image whole(1280, 960);
+    EXPECT_EQ(*treeFoliageOf(header, "fine.exr", &whole), sums);
+    EXPECT_EQ(*treeFoliageOf(header, "fine.exr"), sums);
+    // Without the frame (files written before it): as summed.
+    EXPECT_EQ(*treeFoliageOf(Metadata{header[0]}, "old.exr", &small), sums);
+    for (const char* bad :
+         {"1280", "1280x", "x960", "0x960", "1280x960x", "1280 x 960", "-1x5", "01280x960"}) {
+        const Metadata damaged{header[0], {kTreeFoliageFrameAttribute, std::string(bad)}};
+        try {
+            treeFoliageOf(damaged, "bad.exr", &small);
+            ADD_FAILURE() << bad << " was read as a frame";
+        } catch (const ImageError& e) {
+            EXPECT_NE(std::string(e.what()).find("bad.exr"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(kTreeFoliageFrameAttribute), std::string::npos);
+        }
+    }
+    EXPECT_THROW(treeFoliageOf(Metadata{header[0], {kTreeFoliageFrameAttribute, 3}}, "x", &small),
+                 ImageError);
+}
+
 TEST(TreeFoliage, ASummaryHasTheMedianTheWorstWithItsSignAndTheTreesBeyond)
 {
     const auto bias = [](int tree, double luminance, double coverage) {

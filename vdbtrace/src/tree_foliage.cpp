@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <deque>
 #include <limits>
 #include <map>
@@ -160,16 +161,47 @@ std::vector<TreeFoliageSum> parseTreeFoliage(const std::string& text, const std:
     return out;
 }
 
-std::optional<std::vector<TreeFoliageSum>> treeFoliageOf(const Metadata& metadata,
-                                                          const std::string& where)
+std::string frameText(int width, int height)
 {
-    for (const auto& [key, value] : metadata) {
-        if (key != kTreeFoliageAttribute) continue;
-        const std::string* text = std::get_if<std::string>(&value);
-        if (!text) throw ImageError(where + ": " + kTreeFoliageAttribute + " is not text");
-        return parseTreeFoliage(*text, where);
+    return std::to_string(width) + "x" + std::to_string(height);
+}
+
+std::optional<std::vector<TreeFoliageSum>> treeFoliageOf(const Metadata& metadata,
+                                                         const std::string& where,
+                                                         const Image* image)
+{
+    const auto text = [&](const char* name) -> const std::string* {
+        for (const auto& [key, value] : metadata) {
+            if (key != name) continue;
+            const std::string* t = std::get_if<std::string>(&value);
+            if (!t) throw ImageError(where + ": " + name + " is not text");
+            return t;
+        }
+        return nullptr;
+    };
+    const std::string* sumsText = text(kTreeFoliageAttribute);
+    if (!sumsText) return std::nullopt;
+    std::vector<TreeFoliageSum> sums = parseTreeFoliage(*sumsText, where);
+    const std::string* frame = text(kTreeFoliageFrameAttribute);
+    if (!frame || !image) return sums;
+    int w = 0, h = 0;
+    char x = 0, rest = 0;
+    if (std::sscanf(frame->c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || x != 'x' || w < 1 ||
+        h < 1 || *frame != frameText(w, h)) {
+        throw ImageError(where + ": " + kTreeFoliageFrameAttribute + " is '" + *frame +
+                         "', not WIDTHxHEIGHT");
     }
-    return std::nullopt;
+    const int W = image->frameWidth > 0 ? image->frameWidth : image->width;
+    const int H = image->frameHeight > 0 ? image->frameHeight : image->height;
+    if (W == w && H == h) return sums;
+    // A pixel of the image holds (w h) / (W H) of the frame's: as many pixels' worth of each
+    // tree's foliage, and its luminance summed over them.
+    const double scale = (double(W) * double(H)) / (double(w) * double(h));
+    for (TreeFoliageSum& t : sums) {
+        t.coverage_px *= scale;
+        t.luminance *= scale;
+    }
+    return sums;
 }
 
 std::vector<TreeBias> treeBiases(const std::vector<TreeFoliageSum>& image,

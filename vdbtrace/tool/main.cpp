@@ -699,6 +699,8 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
         if (!result.treeFoliage.empty()) {
             metadata.emplace_back(vdbtrace::kTreeFoliageAttribute,
                                   vdbtrace::treeFoliageText(result.treeFoliage));
+            metadata.emplace_back(vdbtrace::kTreeFoliageFrameAttribute,
+                                  vdbtrace::frameText(camera.width(), camera.height()));
         }
         for (const auto& [key, value] : methodSettings.items()) {
             if (value.is_number_integer()) {
@@ -1283,8 +1285,8 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
     // Per tree: fragment by fragment where both renders summed their trees so
     // (tree_foliage_tally.h), else over the regions of the reference's "tree" AOV.
     std::string worst;
-    const auto imageTrees = vdbtrace::treeFoliageOf(imageHeader, a.string());
-    const auto referenceTrees = vdbtrace::treeFoliageOf(referenceHeader, b.string());
+    const auto imageTrees = vdbtrace::treeFoliageOf(imageHeader, a.string(), &image);
+    const auto referenceTrees = vdbtrace::treeFoliageOf(referenceHeader, b.string(), &reference);
     const bool byFragments = imageTrees && referenceTrees;
     if (byFragments || (reference.aovs.count("tree") && reference.aovs.count("foliage") &&
                         image.aovs.count("foliage"))) {

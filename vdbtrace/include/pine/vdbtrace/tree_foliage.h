@@ -66,11 +66,21 @@ std::vector<TreeBias> treeBiases(const Image& image, const Image& truth, double 
 /// under, as JSON text [[tree, coverage_px, luminance], ...]: numbers written to round trip.
 inline constexpr const char* kTreeFoliageAttribute = "pine:tree_foliage";
 std::string treeFoliageText(const std::vector<TreeFoliageSum>& sums);
+/// The EXR header attribute naming the frame the sums count pixels of, as "WxH" (the whole
+/// frame, a crop's too): an image resized after it was written (oiiotool --resize, to compare
+/// a fine render with a truth at the scene's resolution) keeps the sums of the pixels it was
+/// rendered with, and is read in its own (treeFoliageOf).
+inline constexpr const char* kTreeFoliageFrameAttribute = "pine:tree_foliage_frame";
+std::string frameText(int width, int height);
 /// Throws ImageError naming `where` if `text` is not what treeFoliageText writes.
 std::vector<TreeFoliageSum> parseTreeFoliage(const std::string& text, const std::string& where);
-/// The sums an EXR's header carries (readExr's metadata), if it carries them.
+/// The sums an EXR's header carries (readExr's metadata), if it carries them. Where it names
+/// the frame they were summed in (kTreeFoliageFrameAttribute) and `image` (the EXR's pixels,
+/// if given) is a frame of another size, they are scaled to its pixels. Throws ImageError
+/// naming `where` for sums or a frame it cannot read.
 std::optional<std::vector<TreeFoliageSum>> treeFoliageOf(const Metadata& metadata,
-                                                          const std::string& where);
+                                                         const std::string& where,
+                                                         const Image* image = nullptr);
 
 /// Every tree of `truth`, `image` against it, from each render's own sums fragment by fragment
 /// (the exact attribution; TreeBias::*.pixels is 0): coverage ratio - 1 and mean luminance
