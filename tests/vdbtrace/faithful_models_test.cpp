@@ -790,8 +790,11 @@ TEST(FaithfulModels, TheBarkHidesTheNeedlesRootsAndNothingElse)
 // Twigs 6 cm long on branches 0.3 cm thick, far apart, seen as the paper forest sees its
 // boughs (a footprint of two cone spacings): in the needles' truth the branch hides the
 // needles' roots, the darkest of them (7% of the coverage). With render.bark "solid" level 3
-// covers what the needles cover within 6%; with "line" (the paper's axis) it covers the roots
-// as well, 9-10% too much, and its self-shadowed needles are darker.
+// covers what the needles cover within 3% (1.018); with "line" (the paper's axis) it covers
+// the roots as well, 9-10% too much, and its self-shadowed needles are darker. Until the
+// branch hid the rear half's share where it lies across the strip, not its mean over the
+// footprint (its chords are longest over the axis, and more of it lies there), "solid" covered
+// 1.049.
 TEST(FaithfulModels, ABranchHidesItsNeedlesRoots)
 {
     const std::string json = R"({"name": "twigs",
@@ -832,7 +835,7 @@ TEST(FaithfulModels, ABranchHidesItsNeedlesRoots)
                 "luminance %.3f, line %.3f %.3f\n",
                 level3[0].coverage / truth.coverage, level3[0].luminance / truth.luminance,
                 level3[1].coverage / truth.coverage, level3[1].luminance / truth.luminance);
-    EXPECT_NEAR(level3[0].coverage / truth.coverage, 1.0, 0.06);
+    EXPECT_NEAR(level3[0].coverage / truth.coverage, 1.0, 0.03);
     EXPECT_GT(level3[1].coverage / truth.coverage, 1.07);
     EXPECT_LT(std::abs(level3[0].luminance / truth.luminance - 1.0),
               std::abs(level3[1].luminance / truth.luminance - 1.0));

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -524,6 +525,29 @@ TEST(MultiscaleTracer, EveryShippedSceneRendersFiniteAndBounded)
         expectBounded(r.image, entry.path().filename().string());
     }
     EXPECT_GE(found, 4);
+}
+
+TEST(TracedScene, EachBoughKnowsTheBranchItGrowsOn)
+{
+    // Level 3 reads where its own branch hides its rear half from that branch's primitive: the
+    // branch's fragment is drawn from it. Five firs from two variants, whose copies are moved.
+    const TracedScene traced =
+        buildTracedScene(scenes::parseScene(test::variantForest(), "v.json"));
+    ASSERT_GT(traced.boughs.size(), 100u);
+    std::vector<int> growsOn(traced.branches.size(), 0);
+    for (const TracedBough& b : traced.boughs) {
+        ASSERT_LT(b.branch, traced.branches.size());
+        const TracedBranch& branch = traced.branches[b.branch];
+        EXPECT_EQ(branch.base_cm, b.base_cm);
+        EXPECT_EQ(branch.tip_cm, b.tip_cm);
+        EXPECT_EQ(branch.tree, b.tree);
+        EXPECT_GT(b.barkRadius_cm, 0.0);  // render.bark "solid", the default
+        EXPECT_EQ(std::min(branch.radius_cm, b.radius_cm), b.barkRadius_cm);
+        ++growsOn[b.branch];
+    }
+    // One bough a branch at most; the trunk's segments bear none.
+    EXPECT_EQ(*std::max_element(growsOn.begin(), growsOn.end()), 1);
+    EXPECT_GT(std::count(growsOn.begin(), growsOn.end(), 0), 0);
 }
 
 TEST(TracedScene, TheFirstTreeItCannotHoldIsNamed)

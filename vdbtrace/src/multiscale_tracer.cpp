@@ -46,7 +46,10 @@ private:
     void addBough(const ConeRay& ray, std::size_t index);
     // The bough's fragments at `level`, the ray passing its needles at `passage` (base to
     // the cones' end).
-    void addBoughAt(const ConeRay& ray, std::size_t index, Level level, const Passage& passage);
+    // `branchBetween`: the bough's own branch composites between level 3's halves (false where
+    // the bough's fragments are composited alone, within a level blend).
+    void addBoughAt(const ConeRay& ray, std::size_t index, Level level, const Passage& passage,
+                    bool branchBetween = true);
     // Levels 1-2 over [tIn, tOut]; the strip covers `coverage` of the footprint, `w` wide, at
     // signed offset xi from the axis.
     void addCrossings(const ConeRay& ray, std::size_t index, const TracedBough& b, double tIn,
@@ -380,6 +383,33 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
     shadeNeedles(ray, index, b, tIn, tOut, 1);
 }
 
+// Where a bough's own branch covers the footprint of a cone passing the bough's strip at
+// signed offset xi, w wide, where its bark is solid (render.bark "solid"): its coverage and
+// depth as the branch's fragment has them (SurfaceShading::branch), and the part of the strip
+// it spans there, [from, to]. Zero coverage where the footprint misses it.
+struct BarkInFootprint {
+    double coverage = 0.0, t = 0.0, from = 0.0, to = 0.0;
+};
+BarkInFootprint barkInFootprint(const ConeRay& ray, const TracedScene& scene, const TracedBough& b,
+                                double xi, double w)
+{
+    if (!(b.barkRadius_cm > 0.0) || b.branch == TracedBough::kNoBranch) return {};
+    const TracedBranch& branch = scene.branches[b.branch];
+    const double across = std::min(branch.radius_cm, b.radius_cm);  // of the strip
+    BarkInFootprint out;
+    out.from = std::max(xi - 0.5 * w, -across);
+    out.to = std::min(xi + 0.5 * w, across);
+    Passage p;
+    if (!(out.to > out.from) || !closestPassage(ray, branch.base_cm, branch.tip_cm, p)) return {};
+    const double c = stripCoverage(p.gap, branch.radius_cm, ray.width(p.t));
+    if (!(c > 0.0)) return {};
+    double tIn = p.t, tOut;
+    intersectCylinder(ray, branch.base_cm, branch.tip_cm, branch.radius_cm, tIn, tOut);
+    out.coverage = std::min(c, 0.999);
+    out.t = tIn;
+    return out;
+}
+
 void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
 {
     const TracedBough& b = mScene.bough(index);
@@ -394,9 +424,9 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     // Within a band about a threshold: each level's fragments composited alone, the two
     // results mixed, as one fragment at the bough's front.
     const std::size_t from = mFragments.size();
-    addBoughAt(ray, index, blend.lower, p);
+    addBoughAt(ray, index, blend.lower, p, /*branchBetween=*/false);
     const std::size_t middle = mFragments.size();
-    addBoughAt(ray, index, blend.upper, p);
+    addBoughAt(ray, index, blend.upper, p, /*branchBetween=*/false);
     const auto composite = [&](std::size_t a, std::size_t z) {
         std::sort(mFragments.begin() + a, mFragments.begin() + z,
                   [](const Fragment& x, const Fragment& y) { return x.t < y.t; });
@@ -418,7 +448,7 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
 }
 
 void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Level level,
-                                     const Passage& passage)
+                                     const Passage& passage, bool branchBetween)
 {
     const TracedBough& b = mScene.bough(index);
     Passage p = passage;
@@ -455,12 +485,33 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     // What the rear's share is divided by to composite behind the front (bough_law.h).
     const double behindFront =
         b.rearComposite == RearComposite::Share ? 1.0 - frontAlpha : 1.0;
+    // The bough's own branch lies between the halves and hides the rear's needles behind it,
+    // where it lies across the strip: the rear's share there, not its mean over the footprint
+    // (the rear's chords are longest over the axis, and more of it lies there). A footprint
+    // composited as if even across it had hidden too little of the rear: level 3 covered 1.049
+    // of the needles on thin twigs (FaithfulModels.ABranchHidesItsNeedlesRoots), now 1.018.
+    const BarkInFootprint bark = b.rearComposite == RearComposite::Share
+                                     ? barkInFootprint(ray, mScene, b, xi, w)
+                                     : BarkInFootprint{};
+    const double behindBark = branchBetween ? 1.0 - bark.coverage : 1.0;
     const auto rearPart = [&](const StripProfile& profile) {
-        return behindFront > 1e-9 ? profile.overFootprint(xi, R, w) / behindFront : 0.0;
+        double share = profile.overFootprint(xi, R, w);
+        if (bark.coverage > 0.0) {
+            share -= bark.coverage *
+                     profile.overFootprint(0.5 * (bark.from + bark.to), R, bark.to - bark.from);
+        }
+        const double through = behindFront * behindBark;
+        return through > 1e-9 ? std::max(0.0, share) / through : 0.0;
     };
     const double tMid = 0.5 * (tIn + tOut);
     Fragment front{tIn, frontAlpha, Vec3(0.0), Vec3(0.0), 3, true, b.tree};
-    Fragment rear{tMid, rearPart(view.alpha.rear), Vec3(0.0), Vec3(0.0), 3, true, b.tree};
+    // Behind the branch's fragment, which may lie as deep where the ray misses the branch.
+    const double tRear =
+        bark.coverage > 0.0 && branchBetween
+            ? std::max(tMid, std::nextafter(bark.t, std::numeric_limits<double>::infinity()))
+            : tMid;
+    Fragment rear{tRear, std::min(rearPart(view.alpha.rear), 1.0), Vec3(0.0), Vec3(0.0), 3, true,
+                  b.tree};
     // The light at the chord's middle, or with shadow_origin "axis" where the ray passes the
     // axis.
     const double tLight = mScene.shadowOrigin == ShadowOrigin::Axis ? p.t : tMid;

@@ -653,7 +653,8 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
             // A variant's copies bear its first tree's needles (geometry instances them).
             d.seed = unsigned(firstOf(i) * 7919u + j * 104729u + scene.trees[i].seed);
             d.tree = int(i);
-            if (solidBark) d.barkRadius_cm = tree.segments[tree.boughs[j].segment].radius_cm;
+            d.segment = long(tree.boughs[j].segment);
+            if (solidBark) d.barkRadius_cm = tree.segments[d.segment].radius_cm;
             described[i].push_back(d);
         }
     });
@@ -695,6 +696,9 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
         for (std::size_t k = 0; k < described[i].size(); ++k) {
             TracedBough& b = out.boughs[firstBough[i] + k];
             b = makeTracedBough(described[i][k], context, parts.boughLaws);
+            if (described[i][k].segment >= 0) {
+                b.branch = std::uint32_t(firstBranch[i] + std::size_t(described[i][k].segment));
+            }
         }
         std::vector<BoughDescription>().swap(described[i]);
     });

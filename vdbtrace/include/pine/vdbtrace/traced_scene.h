@@ -111,6 +111,8 @@ struct BoughDescription {
     /// The radius of the branch the needles grow from, where render.bark is "solid": the
     /// needles' roots within it lie inside the bark. 0: the branch is the bough's axis.
     double barkRadius_cm = 0.0;
+    /// Its tree's segment the bough grows on, whose branch buildTracedScene makes: -1 none.
+    long segment = -1;
 };
 
 struct TracedBough {
@@ -142,6 +144,10 @@ struct TracedBough {
     bool stripToConesEnd = false;  ///< the law's strip ends at conesEnd(), else at the tip
     unsigned seed = 0;          ///< drives the needles' azimuths at level 1
     int tree = -1;              ///< index of its tree in the scene's trees
+    /// The branch primitive it grows on (TracedScene::branches; its base, tip and the bark's
+    /// radius are the bough's), or kNoBranch.
+    std::uint32_t branch = kNoBranch;
+    static constexpr std::uint32_t kNoBranch = std::uint32_t(-1);
 
     /// The bough law's profiles seen from the camera, computed on first use, from any thread:
     /// a bough that no cone meets at level 3 never pays for them. A scene's boughs keep their
