@@ -15,6 +15,8 @@
 #include "pine/vdbtrace/reference_tracer.h"
 #include "pine/vdbtrace/traced_scene.h"
 
+#include "test_scenes.h"
+
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
@@ -839,6 +841,43 @@ TEST(FaithfulModels, ABranchHidesItsNeedlesRoots)
     EXPECT_GT(level3[1].coverage / truth.coverage, 1.07);
     EXPECT_LT(std::abs(level3[0].luminance / truth.luminance - 1.0),
               std::abs(level3[1].luminance / truth.luminance - 1.0));
+}
+
+// The tracer tests' fir, whose branches (1.3 to 2 cm) are as thick as its boughs' reach, seen
+// where its boughs' footprints span the bands about the level thresholds in which two levels
+// are mixed (render.level_blend). Each level's fragments are composited alone there, then
+// mixed at the bough's front: the bough's own branch must be composited with them, where it
+// hides what lies behind it, as it is outside the bands. Behind the mixed fragment it had
+// hidden none of its bough: the fir covered 1.214 of the needles, 0.974 without the bands.
+TEST(FaithfulModels, ABoughsBranchHidesItsNeedlesWithinALevelBlend)
+{
+    const scenes::Scene scene =
+        scenes::parseScene(test::firScene(R"("diffuse")", 96, 72), "fir.json");
+    const TracedScene traced = buildTracedScene(scene);
+    const auto coverage = [](const RenderResult& r) {
+        double sum = 0.0;
+        for (const float f : r.image.aovs.at("foliage")) sum += f;
+        return sum;
+    };
+    GeometryOptions g;
+    g.samples = 64;
+    const double needles = coverage(renderGeometry(traced, g));
+    const RenderResult blended = renderMultiscale(traced);
+    scenes::Scene unblended = scene;
+    unblended.render.model.levelBlend = 1.0;
+    const RenderResult apart = renderMultiscale(buildTracedScene(unblended));
+    int mixed = 0;  // pixels whose foliage the bands change
+    const std::vector<float>& a = blended.image.aovs.at("foliage");
+    const std::vector<float>& b = apart.image.aovs.at("foliage");
+    for (std::size_t i = 0; i < a.size(); ++i) mixed += std::abs(a[i] - b[i]) > 0.01f;
+    const double within = coverage(blended), without = coverage(apart);
+    std::printf(
+        "the tests' fir over its needles: coverage %.3f with the level bands, %.3f "
+        "without (%d pixels changed)\n",
+        within / needles, without / needles, mixed);
+    EXPECT_GT(mixed, 300);
+    EXPECT_NEAR(within / needles, 1.0, 0.05);
+    EXPECT_NEAR(within / without, 1.0, 0.06);
 }
 
 }  // namespace

@@ -111,6 +111,11 @@ private:
     static constexpr std::uint32_t kGround = std::uint32_t(-1);  ///< in mQueue
     NearestFirstQueue mQueue;  ///< the primitives the ray may yet meet
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
+    /// The branches whose fragments this ray made, where trace() met them or a bough within a
+    /// level blend composited its own (addBough): each once.
+    std::vector<std::uint32_t> mBranchesMade;
+    bool branchMade(std::uint32_t branch) const;
+    double mTMax = 0.0;  ///< this ray's: where it meets the ground, else infinity
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
     std::vector<double> mLayerLit;  ///< their (or level 1's needles') self-shadowing, one light
     std::vector<LayerModel::NeedleOnLine> mNeedlesOnRay;  ///< level 1's, for the layer model
@@ -422,29 +427,67 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     if (!(blend.upperWeight > 0.0)) return addBoughAt(ray, index, blend.lower, p);
     if (!(blend.upperWeight < 1.0)) return addBoughAt(ray, index, blend.upper, p);
     // Within a band about a threshold: each level's fragments composited alone, the two
-    // results mixed, as one fragment at the bough's front.
+    // results mixed, at the bough's front. The bough's own branch is composited with each, at
+    // its depth among them, so that it hides what lies behind it as it does outside the band:
+    // behind the mixed fragment it had hidden none of its bough, and a fir whose branches
+    // are as thick as its boughs' reach covered 1.214 of the needles (0.974 with no band).
+    // The mix is two fragments, the needles' and then what shows of the branch, so that the
+    // foliage is the needles' alone.
+    Fragment branch;
+    const bool withBranch = b.branch != TracedBough::kNoBranch && !branchMade(b.branch) &&
+                            mSurfaces.branch(ray, b.branch, mTMax, branch);
+    if (b.branch != TracedBough::kNoBranch) mBranchesMade.push_back(b.branch);
     const std::size_t from = mFragments.size();
-    addBoughAt(ray, index, blend.lower, p, /*branchBetween=*/false);
+    addBoughAt(ray, index, blend.lower, p, withBranch);
+    if (withBranch) mFragments.push_back(branch);
     const std::size_t middle = mFragments.size();
-    addBoughAt(ray, index, blend.upper, p, /*branchBetween=*/false);
+    addBoughAt(ray, index, blend.upper, p, withBranch);
+    if (withBranch) mFragments.push_back(branch);
+    // What the needles (foliage) and the rest show, composited front to back (FrontToBack).
+    struct Shown {
+        double needles = 0.0, rest = 0.0;
+        Vec3 needlesDiffuse{0.0}, needlesSpecular{0.0}, restDiffuse{0.0}, restSpecular{0.0};
+    };
     const auto composite = [&](std::size_t a, std::size_t z) {
         std::sort(mFragments.begin() + a, mFragments.begin() + z,
                   [](const Fragment& x, const Fragment& y) { return x.t < y.t; });
-        FrontToBack local;
-        for (std::size_t i = a; i < z; ++i) local.add(mFragments[i]);
-        return local.value();
+        Shown shown;
+        double alpha = 0.0;
+        for (std::size_t i = a; i < z; ++i) {
+            const Fragment& f = mFragments[i];
+            const double through = 1.0 - alpha;
+            (f.foliage ? shown.needles : shown.rest) += through * f.alpha;
+            (f.foliage ? shown.needlesDiffuse : shown.restDiffuse) += through * f.diffuse;
+            (f.foliage ? shown.needlesSpecular : shown.restSpecular) += through * f.specular;
+            alpha += through * f.alpha;
+        }
+        return shown;
     };
-    const SampleValue lo = composite(from, middle), hi = composite(middle, mFragments.size());
+    const Shown lo = composite(from, middle), hi = composite(middle, mFragments.size());
     const double u = blend.upperWeight;
     double t = std::numeric_limits<double>::infinity();
     for (std::size_t i = from; i < mFragments.size(); ++i) t = std::min(t, mFragments[i].t);
     mFragments.resize(from);
-    if (!(lo.alpha + hi.alpha > 0.0)) return;
-    mFragments.push_back(Fragment{t, (1.0 - u) * lo.alpha + u * hi.alpha,
-                                  (1.0 - u) * lo.diffuse + u * hi.diffuse,
-                                  (1.0 - u) * lo.specular + u * hi.specular,
-                                  int(u < 0.5 ? blend.lower : blend.upper), true,
-                                  mScene.bough(index).tree});
+    const auto mix = [&](double Shown::*part) { return (1.0 - u) * lo.*part + u * hi.*part; };
+    const auto mixed = [&](Vec3 Shown::*part) { return (1.0 - u) * lo.*part + u * hi.*part; };
+    const double needles = std::min(mix(&Shown::needles), 1.0);
+    if (needles > 0.0) {
+        mFragments.push_back(Fragment{t, needles, mixed(&Shown::needlesDiffuse),
+                                      mixed(&Shown::needlesSpecular),
+                                      int(u < 0.5 ? blend.lower : blend.upper), true, b.tree});
+    }
+    const double rest = mix(&Shown::rest);
+    if (withBranch && rest > 0.0 && needles < 1.0) {
+        const double behind = 1.0 - needles;  // what the needles' fragment leaves
+        mFragments.push_back(
+            Fragment{t, std::min(rest / behind, 1.0), mixed(&Shown::restDiffuse) / behind,
+                     mixed(&Shown::restSpecular) / behind, branch.level, false, branch.tree});
+    }
+}
+
+bool MultiscaleRayTracer::branchMade(std::uint32_t branch) const
+{
+    return std::find(mBranchesMade.begin(), mBranchesMade.end(), branch) != mBranchesMade.end();
 }
 
 void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Level level,
@@ -609,6 +652,8 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     Vec3 normal;
     const bool hasGround = hitGround(mScene.scene->ground, ray, tGround, normal);
     const double tMax = hasGround ? tGround : std::numeric_limits<double>::infinity();
+    mTMax = tMax;
+    mBranchesMade.clear();
     mQueue.clear();
     if (hasGround) mQueue.add(tGround, kGround);
     mFragments.clear();
@@ -664,7 +709,8 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
             }
             if (!mScene.isBranch(index)) {
                 addBough(ray, index);
-            } else {
+            } else if (!branchMade(index)) {
+                mBranchesMade.push_back(index);
                 Fragment f;
                 if (mSurfaces.branch(ray, index, tMax, f)) mFragments.push_back(f);
             }
