@@ -10,6 +10,7 @@
 #include "pine/vdbtrace/geometry.h"
 #include "pine/vdbtrace/strip_profile.h"
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -20,7 +21,7 @@ struct TracedBough;
 class LayerModel;
 
 /// How the rear half's profiles composite behind the front's.
-enum class RearComposite {
+enum class RearComposite : std::uint8_t {  // one byte: a landscape holds 3.3 million boughs
     /// The rear profiles are its own opacity and radiance, composited as they are behind the
     /// front (the paper's section 6.6 alphas).
     Own,

@@ -142,12 +142,12 @@ struct TracedBough {
     RearComposite rearComposite = RearComposite::Own;  ///< how the law's rear half composites
     bool shadesNeedles = false;  ///< level 3 reflects the law's diffuse and specular profiles
     bool stripToConesEnd = false;  ///< the law's strip ends at conesEnd(), else at the tip
-    unsigned seed = 0;          ///< drives the needles' azimuths at level 1
-    int tree = -1;              ///< index of its tree in the scene's trees
     /// The branch primitive it grows on (TracedScene::branches; its base, tip and the bark's
-    /// radius are the bough's), or kNoBranch.
+    /// radius are the bough's), or kNoBranch. Beside the one-byte fields, in what was padding.
     std::uint32_t branch = kNoBranch;
     static constexpr std::uint32_t kNoBranch = std::uint32_t(-1);
+    unsigned seed = 0;  ///< drives the needles' azimuths at level 1
+    int tree = -1;      ///< index of its tree in the scene's trees
 
     /// The bough law's profiles seen from the camera, computed on first use, from any thread:
     /// a bough that no cone meets at level 3 never pays for them. A scene's boughs keep their
