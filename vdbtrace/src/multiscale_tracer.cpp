@@ -46,8 +46,9 @@ private:
     void addBough(const ConeRay& ray, std::size_t index);
     // The bough's fragments at `level`, the ray passing its needles at `passage` (base to
     // the cones' end).
-    // `branchBetween`: the bough's own branch composites between level 3's halves (false where
-    // the bough's fragments are composited alone, within a level blend).
+    // `branchBetween`: the bough's own branch's fragment composites with these fragments, at
+    // its depth between level 3's halves (false within a level blend whose branch this ray
+    // drew before, or misses).
     void addBoughAt(const ConeRay& ray, std::size_t index, Level level, const Passage& passage,
                     bool branchBetween = true);
     // Levels 1-2 over [tIn, tOut]; the strip covers `coverage` of the footprint, `w` wide, at
