@@ -24,6 +24,11 @@ namespace {
 
 constexpr double kPi = analytic::kPi;
 
+bool contains(const std::vector<std::uint32_t>& indices, std::uint32_t index)
+{
+    return std::find(indices.begin(), indices.end(), index) != indices.end();
+}
+
 // One thread's tracer. Its light transport is the cone shadow ray through the branches and
 // the boughs, each bough by its law's opacity seen from the light.
 class MultiscaleRayTracer final : public ShadingMethod::RayTracer, private LightTransport {
@@ -112,10 +117,9 @@ private:
     static constexpr std::uint32_t kGround = std::uint32_t(-1);  ///< in mQueue
     NearestFirstQueue mQueue;  ///< the primitives the ray may yet meet
     std::vector<std::pair<long, long>> mNeedlesSeen;  ///< (cone, needle) found on this ray
-    /// The branches whose fragments this ray made, where trace() met them or a bough within a
-    /// level blend composited its own (addBough): each once.
-    std::vector<std::uint32_t> mBranchesMade;
-    bool branchMade(std::uint32_t branch) const;
+    /// The branches this ray met (trace()) and those a bough within a level blend composited
+    /// with its own fragments (addBough), which trace() does not draw again.
+    std::vector<std::uint32_t> mBranchesMet, mBranchesOfBlends;
     double mTMax = 0.0;  ///< this ray's: where it meets the ground, else infinity
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
     std::vector<double> mLayerLit;  ///< their (or level 1's needles') self-shadowing, one light
@@ -391,29 +395,22 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
 
 // Where a bough's own branch covers the footprint of a cone passing the bough's strip at
 // signed offset xi, w wide, where its bark is solid (render.bark "solid"): its coverage and
-// depth as the branch's fragment has them (SurfaceShading::branch), and the part of the strip
+// depth as the branch's fragment has them (hitBranch, before tMax), and the part of the strip
 // it spans there, [from, to]. Zero coverage where the footprint misses it.
 struct BarkInFootprint {
     double coverage = 0.0, t = 0.0, from = 0.0, to = 0.0;
 };
 BarkInFootprint barkInFootprint(const ConeRay& ray, const TracedScene& scene, const TracedBough& b,
-                                double xi, double w)
+                                double xi, double w, double tMax)
 {
     if (!(b.barkRadius_cm > 0.0) || b.branch == TracedBough::kNoBranch) return {};
-    const TracedBranch& branch = scene.branches[b.branch];
-    const double across = std::min(branch.radius_cm, b.radius_cm);  // of the strip
-    BarkInFootprint out;
-    out.from = std::max(xi - 0.5 * w, -across);
-    out.to = std::min(xi + 0.5 * w, across);
-    Passage p;
-    if (!(out.to > out.from) || !closestPassage(ray, branch.base_cm, branch.tip_cm, p)) return {};
-    const double c = stripCoverage(p.gap, branch.radius_cm, ray.width(p.t));
-    if (!(c > 0.0)) return {};
-    double tIn = p.t, tOut;
-    intersectCylinder(ray, branch.base_cm, branch.tip_cm, branch.radius_cm, tIn, tOut);
-    out.coverage = std::min(c, 0.999);
-    out.t = tIn;
-    return out;
+    BranchHit hit;
+    if (!hitBranch(ray, scene.branches[b.branch], tMax, hit)) return {};
+    // The bark radius is the branch's, capped at the strip's half-width R.
+    BarkInFootprint out{std::min(hit.coverage, 0.999), hit.t,
+                        std::max(xi - 0.5 * w, -b.barkRadius_cm),
+                        std::min(xi + 0.5 * w, b.barkRadius_cm)};
+    return out.to > out.from ? out : BarkInFootprint{};
 }
 
 void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
@@ -435,9 +432,10 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     // The mix is two fragments, the needles' and then what shows of the branch, so that the
     // foliage is the needles' alone.
     Fragment branch;
-    const bool withBranch = b.branch != TracedBough::kNoBranch && !branchMade(b.branch) &&
-                            mSurfaces.branch(ray, b.branch, mTMax, branch);
-    if (b.branch != TracedBough::kNoBranch) mBranchesMade.push_back(b.branch);
+    const bool withBranch =
+        b.branch != TracedBough::kNoBranch && !contains(mBranchesMet, b.branch) &&
+        !contains(mBranchesOfBlends, b.branch) && mSurfaces.branch(ray, b.branch, mTMax, branch);
+    if (withBranch) mBranchesOfBlends.push_back(b.branch);
     const std::size_t from = mFragments.size();
     addBoughAt(ray, index, blend.lower, p, withBranch);
     if (withBranch) mFragments.push_back(branch);
@@ -469,26 +467,20 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     double t = std::numeric_limits<double>::infinity();
     for (std::size_t i = from; i < mFragments.size(); ++i) t = std::min(t, mFragments[i].t);
     mFragments.resize(from);
-    const auto mix = [&](double Shown::*part) { return (1.0 - u) * lo.*part + u * hi.*part; };
-    const auto mixed = [&](Vec3 Shown::*part) { return (1.0 - u) * lo.*part + u * hi.*part; };
+    const auto mix = [&](auto Shown::*part) { return (1.0 - u) * lo.*part + u * hi.*part; };
     const double needles = std::min(mix(&Shown::needles), 1.0);
     if (needles > 0.0) {
-        mFragments.push_back(Fragment{t, needles, mixed(&Shown::needlesDiffuse),
-                                      mixed(&Shown::needlesSpecular),
+        mFragments.push_back(Fragment{t, needles, mix(&Shown::needlesDiffuse),
+                                      mix(&Shown::needlesSpecular),
                                       int(u < 0.5 ? blend.lower : blend.upper), true, b.tree});
     }
     const double rest = mix(&Shown::rest);
     if (withBranch && rest > 0.0 && needles < 1.0) {
         const double behind = 1.0 - needles;  // what the needles' fragment leaves
         mFragments.push_back(
-            Fragment{t, std::min(rest / behind, 1.0), mixed(&Shown::restDiffuse) / behind,
-                     mixed(&Shown::restSpecular) / behind, branch.level, false, branch.tree});
+            Fragment{t, std::min(rest / behind, 1.0), mix(&Shown::restDiffuse) / behind,
+                     mix(&Shown::restSpecular) / behind, branch.level, false, branch.tree});
     }
-}
-
-bool MultiscaleRayTracer::branchMade(std::uint32_t branch) const
-{
-    return std::find(mBranchesMade.begin(), mBranchesMade.end(), branch) != mBranchesMade.end();
 }
 
 void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Level level,
@@ -519,7 +511,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     }
 
     // Level 3: section 6 per light under the bough law, front half at the entry and rear
-    // half at the middle, so that the branch inside sorts between them. Each profile is read
+    // half at the middle (or just behind the bough's own branch where that lies as deep), so
+    // that the branch inside sorts between them. Each profile is read
     // over the footprint at the chord's signed offset from the axis.
     ++mStats.boughHits;
     const double R = b.radius_cm;
@@ -535,10 +528,10 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     // composited as if even across it had hidden too little of the rear: level 3 covered 1.049
     // of the needles on thin twigs (FaithfulModels.ABranchHidesItsNeedlesRoots), now 1.018.
     const BarkInFootprint bark = b.rearComposite == RearComposite::Share
-                                     ? barkInFootprint(ray, mScene, b, xi, w)
+                                     ? barkInFootprint(ray, mScene, b, xi, w, mTMax)
                                      : BarkInFootprint{};
     const double behindBark = branchBetween ? 1.0 - bark.coverage : 1.0;
-    const auto rearPart = [&](const StripProfile& profile) {
+    const auto rearShare = [&](const StripProfile& profile) {
         double share = profile.overFootprint(xi, R, w);
         if (bark.coverage > 0.0) {
             share -= bark.coverage *
@@ -547,6 +540,15 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         const double through = behindFront * behindBark;
         return through > 1e-9 ? std::max(0.0, share) / through : 0.0;
     };
+    // The composite takes the front and the branch as even across the footprint, where the
+    // front is densest over the branch: what it leaves behind them may hold less than the rear
+    // beside the branch. The rear then covers all of it, each of its profiles scaled alike,
+    // so that it reflects what it did per unit of coverage.
+    const double rearAlpha = rearShare(view.alpha.rear);
+    const double rearScale = rearAlpha > 1.0 ? 1.0 / rearAlpha : 1.0;
+    const auto rearPart = [&](const StripProfile& profile) {
+        return rearScale * rearShare(profile);
+    };
     const double tMid = 0.5 * (tIn + tOut);
     Fragment front{tIn, frontAlpha, Vec3(0.0), Vec3(0.0), 3, true, b.tree};
     // Behind the branch's fragment, which may lie as deep where the ray misses the branch.
@@ -554,8 +556,7 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         bark.coverage > 0.0 && branchBetween
             ? std::max(tMid, std::nextafter(bark.t, std::numeric_limits<double>::infinity()))
             : tMid;
-    Fragment rear{tRear, std::min(rearPart(view.alpha.rear), 1.0), Vec3(0.0), Vec3(0.0), 3, true,
-                  b.tree};
+    Fragment rear{tRear, rearScale * rearAlpha, Vec3(0.0), Vec3(0.0), 3, true, b.tree};
     // The light at the chord's middle, or with shadow_origin "axis" where the ray passes the
     // axis.
     const double tLight = mScene.shadowOrigin == ShadowOrigin::Axis ? p.t : tMid;
@@ -654,7 +655,8 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     const bool hasGround = hitGround(mScene.scene->ground, ray, tGround, normal);
     const double tMax = hasGround ? tGround : std::numeric_limits<double>::infinity();
     mTMax = tMax;
-    mBranchesMade.clear();
+    mBranchesMet.clear();
+    mBranchesOfBlends.clear();
     mQueue.clear();
     if (hasGround) mQueue.add(tGround, kGround);
     mFragments.clear();
@@ -710,8 +712,8 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
             }
             if (!mScene.isBranch(index)) {
                 addBough(ray, index);
-            } else if (!branchMade(index)) {
-                mBranchesMade.push_back(index);
+            } else if (!contains(mBranchesOfBlends, index)) {
+                mBranchesMet.push_back(index);
                 Fragment f;
                 if (mSurfaces.branch(ray, index, tMax, f)) mFragments.push_back(f);
             }

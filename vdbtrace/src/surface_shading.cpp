@@ -119,19 +119,27 @@ const std::vector<Incident>& SurfaceShading::lightAt(const Vec3& x, double footp
     return mIncident;
 }
 
+bool hitBranch(const ConeRay& ray, const TracedBranch& branch, double tMax, BranchHit& out)
+{
+    Passage& p = out.passage;
+    if (!closestPassage(ray, branch.base_cm, branch.tip_cm, p)) return false;
+    out.coverage = stripCoverage(p.gap, branch.radius_cm, ray.width(p.t));
+    if (out.coverage <= 0.0) return false;
+    double tOut;
+    out.t = p.t;
+    intersectCylinder(ray, branch.base_cm, branch.tip_cm, branch.radius_cm, out.t, tOut);
+    return !(out.t > tMax);  // behind the ground: hidden, not worth its shadow rays
+}
+
 bool SurfaceShading::branch(const ConeRay& ray, std::size_t index, double tMax, Fragment& out)
 {
     const TracedBranch& br = mScene.branches[index];
-    Passage p;
-    if (!closestPassage(ray, br.base_cm, br.tip_cm, p)) return false;
-    const double w = ray.width(p.t);
-    const double c = stripCoverage(p.gap, br.radius_cm, w);
-    if (c <= 0.0) return false;
-    double tIn = p.t, tOut;
-    intersectCylinder(ray, br.base_cm, br.tip_cm, br.radius_cm, tIn, tOut);
-    if (tIn > tMax) return false;  // behind the ground: hidden, not worth its shadow rays
+    BranchHit hit;
+    if (!hitBranch(ray, br, tMax, hit)) return false;
+    const Passage& p = hit.passage;
+    const double w = ray.width(p.t), c = hit.coverage;
     ++mStats.branchHits;
-    out = Fragment{tIn, c, Vec3(0.0), Vec3(0.0), 0, false, br.tree};
+    out = Fragment{hit.t, c, Vec3(0.0), Vec3(0.0), 0, false, br.tree};
     if (!mPlan.diffuse) return true;
     const Vec3 axis = glm::normalize(br.tip_cm - br.base_cm);
     for (const Incident& light : lightAt(ray.origin + p.t * ray.direction, w, index)) {

@@ -5,9 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <deque>
 #include <limits>
 #include <map>
@@ -182,12 +182,15 @@ std::optional<std::vector<TreeFoliageSum>> treeFoliageOf(const Metadata& metadat
     const std::string* sumsText = text(kTreeFoliageAttribute);
     if (!sumsText) return std::nullopt;
     std::vector<TreeFoliageSum> sums = parseTreeFoliage(*sumsText, where);
+    if (!image) return sums;
     const std::string* frame = text(kTreeFoliageFrameAttribute);
-    if (!frame || !image) return sums;
+    if (!frame) return sums;
     int w = 0, h = 0;
-    char x = 0, rest = 0;
-    if (std::sscanf(frame->c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || x != 'x' || w < 1 ||
-        h < 1 || *frame != frameText(w, h)) {
+    const char* end = frame->data() + frame->size();
+    const auto [x, widthError] = std::from_chars(frame->data(), end, w);
+    const bool read = widthError == std::errc() && x != end && *x == 'x' &&
+                      std::from_chars(x + 1, end, h).ec == std::errc();
+    if (!read || w < 1 || h < 1 || *frame != frameText(w, h)) {
         throw ImageError(where + ": " + kTreeFoliageFrameAttribute + " is '" + *frame +
                          "', not WIDTHxHEIGHT");
     }

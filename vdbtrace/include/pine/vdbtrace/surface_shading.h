@@ -61,6 +61,16 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
                                double footprint_cm, std::size_t self, bool throughBoughs,
                                const ShadowSamples* samples = nullptr);
 
+/// Where a cone ray meets a branch: its axis's closest passage, what of the footprint the
+/// branch's strip covers there (stripCoverage) and the depth at which the axis enters the
+/// branch (the passage's where it misses it). False where the strip covers none of the
+/// footprint or the branch begins beyond tMax.
+struct BranchHit {
+    Passage passage;
+    double coverage = 0.0, t = 0.0;
+};
+bool hitBranch(const ConeRay& ray, const TracedBranch& branch, double tMax, BranchHit& out);
+
 /// Per-thread shading of surfaces: branches as Lambertian cylinders (eq. 1 is the diffuse
 /// cylinder's reflectance, so bark is one), the ground as a Lambertian surface, both lit
 /// through `transport` when the plan has shadows.
