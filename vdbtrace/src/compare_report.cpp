@@ -478,8 +478,7 @@ void writeRowImages(const CompareRun& run, const std::filesystem::path& sceneFil
                            {"pine:setting", r.setting},
                            {"pine:render_seconds", float(r.seconds)}});
         if (!r.treeFoliage.empty()) {
-            m.emplace_back(kTreeFoliageAttribute, treeFoliageText(r.treeFoliage));
-            m.emplace_back(kTreeFoliageFrameAttribute, frameText(camera.width(), camera.height()));
+            addTreeFoliage(m, r.treeFoliage, camera.width(), camera.height());
         }
         writeExr(exrImage(r.image, camera, renderMethod(r.renderer),
                           EffectsPlan::from(scene.effects)),

@@ -166,6 +166,13 @@ std::string frameText(int width, int height)
     return std::to_string(width) + "x" + std::to_string(height);
 }
 
+void addTreeFoliage(Metadata& header, const std::vector<TreeFoliageSum>& sums, int frameWidth,
+                    int frameHeight)
+{
+    header.emplace_back(kTreeFoliageAttribute, treeFoliageText(sums));
+    header.emplace_back(kTreeFoliageFrameAttribute, frameText(frameWidth, frameHeight));
+}
+
 std::optional<std::vector<TreeFoliageSum>> treeFoliageOf(const Metadata& metadata,
                                                          const std::string& where,
                                                          const Image* image)

@@ -697,10 +697,7 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
             metadata.emplace_back("pine:job", job);
         }
         if (!result.treeFoliage.empty()) {
-            metadata.emplace_back(vdbtrace::kTreeFoliageAttribute,
-                                  vdbtrace::treeFoliageText(result.treeFoliage));
-            metadata.emplace_back(vdbtrace::kTreeFoliageFrameAttribute,
-                                  vdbtrace::frameText(camera.width(), camera.height()));
+            vdbtrace::addTreeFoliage(metadata, result.treeFoliage, camera.width(), camera.height());
         }
         for (const auto& [key, value] : methodSettings.items()) {
             if (value.is_number_integer()) {

@@ -72,6 +72,10 @@ std::string treeFoliageText(const std::vector<TreeFoliageSum>& sums);
 /// rendered with, and is read in its own (treeFoliageOf).
 inline constexpr const char* kTreeFoliageFrameAttribute = "pine:tree_foliage_frame";
 std::string frameText(int width, int height);
+/// Adds a render's per-tree sums and the frame they count pixels of (frameWidth x frameHeight,
+/// the camera's whole frame) to an EXR's header: the two attributes treeFoliageOf reads.
+void addTreeFoliage(Metadata& header, const std::vector<TreeFoliageSum>& sums, int frameWidth,
+                    int frameHeight);
 /// Throws ImageError naming `where` if `text` is not what treeFoliageText writes.
 std::vector<TreeFoliageSum> parseTreeFoliage(const std::string& text, const std::string& where);
 /// The sums an EXR's header carries (readExr's metadata), if it carries them. Where it names
