@@ -444,42 +444,48 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     if (withBranch) mFragments.push_back(branch);
     // What the needles (foliage) and the rest show, composited front to back (FrontToBack).
     struct Shown {
-        double needles = 0.0, rest = 0.0;
-        Vec3 needlesDiffuse{0.0}, needlesSpecular{0.0}, restDiffuse{0.0}, restSpecular{0.0};
+        double alpha = 0.0;
+        Vec3 diffuse{0.0}, specular{0.0};
+    };
+    struct Parts {
+        Shown needles, rest;
     };
     const auto composite = [&](std::size_t a, std::size_t z) {
         std::sort(mFragments.begin() + a, mFragments.begin() + z,
                   [](const Fragment& x, const Fragment& y) { return x.t < y.t; });
-        Shown shown;
+        Parts parts;
         double alpha = 0.0;
         for (std::size_t i = a; i < z; ++i) {
             const Fragment& f = mFragments[i];
             const double through = 1.0 - alpha;
-            (f.foliage ? shown.needles : shown.rest) += through * f.alpha;
-            (f.foliage ? shown.needlesDiffuse : shown.restDiffuse) += through * f.diffuse;
-            (f.foliage ? shown.needlesSpecular : shown.restSpecular) += through * f.specular;
+            Shown& part = f.foliage ? parts.needles : parts.rest;
+            part.alpha += through * f.alpha;
+            part.diffuse += through * f.diffuse;
+            part.specular += through * f.specular;
             alpha += through * f.alpha;
         }
-        return shown;
+        return parts;
     };
-    const Shown lo = composite(from, middle), hi = composite(middle, mFragments.size());
+    const Parts lo = composite(from, middle), hi = composite(middle, mFragments.size());
     const double u = blend.upperWeight;
     double t = std::numeric_limits<double>::infinity();
     for (std::size_t i = from; i < mFragments.size(); ++i) t = std::min(t, mFragments[i].t);
     mFragments.resize(from);
-    const auto mix = [&](auto Shown::*part) { return (1.0 - u) * lo.*part + u * hi.*part; };
-    const double needles = std::min(mix(&Shown::needles), 1.0);
-    if (needles > 0.0) {
-        mFragments.push_back(Fragment{t, needles, mix(&Shown::needlesDiffuse),
-                                      mix(&Shown::needlesSpecular),
+    const auto mix = [&](Shown Parts::*part) {
+        const Shown &a = lo.*part, &z = hi.*part;
+        return Shown{(1.0 - u) * a.alpha + u * z.alpha, (1.0 - u) * a.diffuse + u * z.diffuse,
+                     (1.0 - u) * a.specular + u * z.specular};
+    };
+    const Shown needles = mix(&Parts::needles), rest = mix(&Parts::rest);
+    const double covered = std::min(needles.alpha, 1.0);
+    if (covered > 0.0) {
+        mFragments.push_back(Fragment{t, covered, needles.diffuse, needles.specular,
                                       int(u < 0.5 ? blend.lower : blend.upper), true, b.tree});
     }
-    const double rest = mix(&Shown::rest);
-    if (withBranch && rest > 0.0 && needles < 1.0) {
-        const double behind = 1.0 - needles;  // what the needles' fragment leaves
-        mFragments.push_back(
-            Fragment{t, std::min(rest / behind, 1.0), mix(&Shown::restDiffuse) / behind,
-                     mix(&Shown::restSpecular) / behind, branch.level, false, branch.tree});
+    if (withBranch && rest.alpha > 0.0 && covered < 1.0) {
+        const double behind = 1.0 - covered;  // what the needles' fragment leaves
+        mFragments.push_back(Fragment{t, std::min(rest.alpha / behind, 1.0), rest.diffuse / behind,
+                                      rest.specular / behind, branch.level, false, branch.tree});
     }
 }
 
@@ -512,8 +518,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
 
     // Level 3: section 6 per light under the bough law, front half at the entry and rear
     // half at the middle (or just behind the bough's own branch where that lies as deep), so
-    // that the branch inside sorts between them. Each profile is read
-    // over the footprint at the chord's signed offset from the axis.
+    // that the branch inside sorts between them. Each profile is read over the footprint at
+    // the chord's signed offset from the axis.
     ++mStats.boughHits;
     const double R = b.radius_cm;
     const std::shared_ptr<const BoughView> kept = b.view();
