@@ -84,6 +84,7 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
     } else {
         scene.bvh.query(ray, tMax + behind, occluder);
     }
+    if (at.transmittances) *at.transmittances = T;
     double sum = 0.0, weight = 0.0;
     for (std::size_t k = 0; k < T.size(); ++k) {
         sum += at.points[k].weight * T[k];

@@ -35,6 +35,10 @@ struct ShadowSamples {
     /// every line from the disc at one offset: lit from above, a bough seen side-on shades the
     /// needles of another below it by depth alone). Zero: the whole width across every strip.
     Vec3 footprintNormal{0.0};
+    /// Where shadowConeTransmittance writes each point's own transmittance (one per point, in
+    /// their order) besides returning their weighted mean, for samples with points; null:
+    /// nowhere.
+    std::vector<double>* transmittances = nullptr;
 };
 
 /// How light reaches a point through a method's model of the scene: its shadows.
