@@ -13,6 +13,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -23,6 +24,20 @@ namespace pine::vdbtrace {
 namespace {
 
 constexpr double kPi = analytic::kPi;
+
+// Where a bough's needles lie along a cone ray's chord through it, at level 3: each half from
+// the chord's end to its middle, less the bark about the axis within which the layer models
+// count no needle (TracedBough::barkRadius_cm). Each half is taken as three even thirds.
+struct ChordHalves {
+    double tIn, tMid, tOut;      ///< the chord through the bough's cylinder, and its middle
+    double frontEnd, rearStart;  ///< where the bark begins and ends along it (else tMid)
+    /// The middle of third `j` (0-2, front to back) of the front half (`half` 0) or the rear.
+    double third(int half, int j) const
+    {
+        const double u = (j + 0.5) / 3.0;
+        return half == 0 ? tIn + u * (frontEnd - tIn) : rearStart + u * (tOut - rearStart);
+    }
+};
 
 bool contains(const std::vector<std::uint32_t>& indices, std::uint32_t index)
 {
@@ -91,17 +106,18 @@ private:
     // footprint's share of its strip as the law's transfer `litShare` says (most of them along
     // the lit edge of a self-shadowed bough), along the chord [tIn, tOut]. The share is cut
     // into kShadowStrips strips across, each three points per half weighted by what of it is
-    // lit, each reading the occluders over its own width: one line read over the whole
+    // lit (one point in each third of each half of `chord`), each reading the occluders over
+    // its own width: one line read over the whole
     // footprint multiplies the occluders' means and samples the strip's middle, where the
     // branch is, not the lit edge. The weights are the lit share, not what it reflects
-    // towards the camera (the law's diffuse profile), and both halves take one mean: neither
-    // alternative, measured, brings both the paper forest and the two-bough tests closer to
-    // the needles (docs/models.md, "Where along the chord"). `behind` is
-    // the opacity the rear half's light lies behind where the law's rear profile does not
-    // already hold it (RearComposite::Own: the front's), else null.
+    // towards the camera (the law's diffuse profile): that alternative, measured, brings
+    // neither the paper forest nor the two-bough tests closer to the needles (docs/models.md,
+    // "Where along the chord"). `behind` is the opacity the rear half's light lies behind
+    // where the law's rear profile does not already hold it (RearComposite::Own: the
+    // front's), else null. Returns the mean over all points; mThirdShadow holds each third's.
     double shadowAcross(const ConeRay& ray, std::size_t index, std::size_t light,
                         const FrontRearProfile& litShare, const StripProfile* behind, double xi,
-                        double w, double tIn, double tMid, double tOut);
+                        double w, const ChordHalves& chord);
 
     const TracedScene& mScene;
     const EffectsPlan& mPlan;
@@ -133,6 +149,10 @@ private:
     };
     std::vector<Depth> mDepths;  ///< where a bough's lit needles lie: shadowOf
     ShadowSamples mShadowSamples;
+    std::vector<double> mPointShadow;  ///< shadowAcross's: each point's transmittance
+    /// shadowAcross's: the light's transmittance to each third of each half's chord (front,
+    /// rear; front to back), its points' weighted mean across the strips.
+    double mThirdShadow[2][3] = {};
 };
 
 double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std::size_t light,
@@ -149,6 +169,7 @@ double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std:
             {(d.t - tRef) * stretch, d.weight, 0.0, (d.t - tRef) * lift});
     }
     mShadowSamples.footprintNormal = ray.direction;
+    mShadowSamples.transmittances = nullptr;
     return mSurfaces.shadow(light, ray.origin + tRef * ray.direction, ray.width(tRef), index,
                             &mShadowSamples);
 }
@@ -156,9 +177,10 @@ double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std:
 double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index, std::size_t light,
                                          const FrontRearProfile& litShare,
                                          const StripProfile* behind, double xi, double w,
-                                         double tIn, double tMid, double tOut)
+                                         const ChordHalves& chord)
 {
     constexpr int kShadowStrips = 4;
+    const double tIn = chord.tIn, tMid = chord.tMid, tOut = chord.tOut;
     const TracedBough& b = mScene.bough(index);
     const double R = b.radius_cm;
     const double lo = std::max(xi - 0.5 * w, -R), hi = std::min(xi + 0.5 * w, R);
@@ -180,9 +202,8 @@ double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index, 
         if (behind) rear *= 1.0 - behind->overFootprint(at, R, strip);
         // Along the chord, each half's needles at the centres of its thirds.
         for (int j = 0; j < 3; ++j) {
-            const double u = (j + 0.5) / 3.0;
-            for (const auto& [t, weight] : {std::pair{tIn + u * (tMid - tIn), front},
-                                            std::pair{tMid + u * (tOut - tMid), rear}}) {
+            for (const auto& [t, weight] :
+                 {std::pair{chord.third(0, j), front}, std::pair{chord.third(1, j), rear}}) {
                 // From the chord's middle to the point: along the ray, then across the strip.
                 const Vec3 d = (t - tMid) * ray.direction + (at - xi) * b.across;
                 const Vec3 flat = d - glm::dot(d, L) * L;
@@ -195,10 +216,27 @@ double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index, 
     }
     if (!(strip > 0.0) || !(tOut > tIn)) {  // a footprint or a chord of no width: its middle
         mDepths.assign(1, {tMid, 1.0});
-        return shadowOf(ray, index, light, tMid);
+        const double T = shadowOf(ray, index, light, tMid);
+        for (auto& half : mThirdShadow) std::fill(std::begin(half), std::end(half), T);
+        return T;
     }
-    return mSurfaces.shadow(light, ray.origin + tMid * ray.direction, strip, index,
-                            &mShadowSamples);
+    mShadowSamples.transmittances = &mPointShadow;
+    const double T =
+        mSurfaces.shadow(light, ray.origin + tMid * ray.direction, strip, index, &mShadowSamples);
+    // The points went in strip by strip, third by third, front then rear.
+    double sum[2][3] = {}, weight[2][3] = {};
+    for (std::size_t q = 0; q < mPointShadow.size(); ++q) {
+        const std::size_t half = q % 2, third = q / 2 % 3;
+        const double wq = mShadowSamples.points[q].weight;
+        sum[half][third] += wq * mPointShadow[q];
+        weight[half][third] += wq;
+    }
+    for (int h = 0; h < 2; ++h) {
+        for (int j = 0; j < 3; ++j) {
+            mThirdShadow[h][j] = weight[h][j] > 0.0 ? sum[h][j] / weight[h][j] : T;
+        }
+    }
+    return T;
 }
 
 void MultiscaleRayTracer::collectLayers(const ConeRay& ray, const TracedBough& b, double tIn,
@@ -556,6 +594,17 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         return rearScale * rearShare(profile);
     };
     const double tMid = 0.5 * (tIn + tOut);
+    ChordHalves chord{tIn, tMid, tOut, tMid, tMid};
+    if (b.barkRadius_cm > p.gap) {
+        // The bark about the axis, entered and left at p.t -+ its half chord there.
+        const double sinTheta = glm::length(glm::cross(b.axis, ray.direction));
+        if (sinTheta > 1e-9) {
+            const double half =
+                std::sqrt(b.barkRadius_cm * b.barkRadius_cm - p.gap * p.gap) / sinTheta;
+            chord.frontEnd = std::clamp(p.t - half, tIn, tMid);
+            chord.rearStart = std::clamp(p.t + half, tMid, tOut);
+        }
+    }
     Fragment front{tIn, frontAlpha, Vec3(0.0), Vec3(0.0), 3, true, b.tree};
     // Behind the branch's fragment, which may lie as deep where the ray misses the branch.
     const double tRear =
@@ -563,6 +612,24 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
             ? std::max(tMid, std::nextafter(bark.t, std::numeric_limits<double>::infinity()))
             : tMid;
     Fragment rear{tRear, rearScale * rearAlpha, Vec3(0.0), Vec3(0.0), 3, true, b.tree};
+    // With shadow_origin "needles" each half is composited as three fragments, one at the
+    // middle of each third of its needles' chord (`chord`), each lit through its own shadow
+    // lines: shadowAcross places the needles that reflect each half's light evenly in its
+    // thirds, and the fragments hold them so. A neighbour whose needles lie among this
+    // bough's, as a twig or the next bough of a chain does, then hides and shades the thirds
+    // behind its own fragments alone: with one fragment a half it hid the whole half or none
+    // of it, and the half's light was its thirds' mean, while the thirds the neighbour hides
+    // are the ones it shades when the light comes from the camera's side. Forced level 3 on
+    // the paper forest, against level 1 at an eighth of its footprints: -4.0% per tree as two
+    // fragments, -2.5% as six (docs/models.md, "Whole scenes"). shadowAcross has set
+    // mThirdShadow for each light by the time it is read.
+    const bool byThirds = mPlan.shadowRays && mScene.shadowOrigin == ShadowOrigin::Needles;
+    struct Thirds {
+        Vec3 diffuse[3], specular[3];  ///< what each third reflects, as the half's share
+    } thirds[2];                       ///< front, rear
+    for (Thirds& half : thirds) {
+        for (int j = 0; j < 3; ++j) half.diffuse[j] = half.specular[j] = Vec3(0.0);
+    }
     // The light at the chord's middle, or with shadow_origin "axis" where the ray passes the
     // axis.
     const double tLight = mScene.shadowOrigin == ShadowOrigin::Axis ? p.t : tMid;
@@ -570,6 +637,7 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     for (std::size_t i = 0; i < mLight.size(); ++i) {
         const BoughLighting& lit = view.lighting[i];
         mLight[i] = mSurfaces.unshadowed(i, ray.origin + tLight * ray.direction);
+        const Vec3 unshadowed = mLight[i].irradiance;
         // Without self-shadowing the whole opacity reflects; with it, the law's transfer.
         const FrontRearProfile& transfer = mPlan.selfShadowing ? lit.transfer : view.alpha;
         const double tf = transfer.front.overFootprint(xi, R, w);
@@ -585,9 +653,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
             // across the strip as the law's transfer says.
             mLight[i].irradiance *=
                 shadowAcross(ray, index, i, transfer,
-                             b.rearComposite == RearComposite::Share ? nullptr
-                                                                     : &view.alpha.front,
-                             xi, w, tIn, tMid, tOut);
+                             b.rearComposite == RearComposite::Share ? nullptr : &view.alpha.front,
+                             xi, w, chord);
         }
         const Vec3& E = mLight[i].irradiance;
         // What each half reflects: the law's sum over its needles, or (the paper's laws) the
@@ -597,22 +664,66 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
             f = b.shadesNeedles ? perNeedle.front.overFootprint(xi, R, w) : tf * frontFace;
             r = b.shadesNeedles ? rearPart(perNeedle.rear) : tr * rearFace;
         };
+        // Each third's share of a half's reflectance `f`, lit through its own shadow lines.
+        const auto byThird = [&](Vec3(Thirds::*part)[3], int half, const Vec3& f) {
+            for (int j = 0; j < 3; ++j) {
+                (thirds[half].*part)[j] += f / 3.0 * mThirdShadow[half][j] * unshadowed;
+            }
+        };
         double f, r;
         if (mPlan.diffuse) {
             reflected(lit.diffuse, lit.front.diffuse, lit.rear.diffuse, f, r);
             front.diffuse += f * b.needleAlbedo / kPi * E;
             rear.diffuse += r * b.needleAlbedo / kPi * E;
+            if (byThirds) {
+                byThird(&Thirds::diffuse, 0, f * b.needleAlbedo / kPi);
+                byThird(&Thirds::diffuse, 1, r * b.needleAlbedo / kPi);
+            }
             mStats.diffuseEvaluations += 2;
         }
         if (mPlan.specular) {
             reflected(lit.specular, lit.front.specular, lit.rear.specular, f, r);
             front.specular += f * b.specularWeight * E;
             rear.specular += r * b.specularWeight * E;
+            if (byThirds) {
+                byThird(&Thirds::specular, 0, Vec3(f * b.specularWeight));
+                byThird(&Thirds::specular, 1, Vec3(r * b.specularWeight));
+            }
             mStats.specularEvaluations += 2;
         }
     }
-    mFragments.push_back(front);
-    mFragments.push_back(rear);
+    if (!byThirds) {
+        mFragments.push_back(front);
+        mFragments.push_back(rear);
+        return;
+    }
+    // Each third shows a third of its half's opacity and light: composited alone, the three
+    // give the half's alpha and, lit alike, its light.
+    const auto addThirds = [&](const Fragment& half, const Thirds& light,
+                               const std::array<double, 3>& depths) {
+        const double A = half.alpha;
+        for (int j = 0; j < 3; ++j) {
+            const double through = 1.0 - j * A / 3.0;  // what the thirds in front leave
+            Fragment third = half;
+            third.t = depths[j];
+            third.alpha = std::min(1.0, A / 3.0 / through);
+            third.diffuse = light.diffuse[j] / through;
+            third.specular = light.specular[j] / through;
+            mFragments.push_back(third);
+        }
+    };
+    // The front's thirds in front of the bough's own branch where it lies in the footprint,
+    // as the front was; the rear's behind it.
+    const double branchEntry =
+        bark.coverage > 0.0 ? std::nextafter(bark.t, -std::numeric_limits<double>::infinity())
+                            : std::numeric_limits<double>::infinity();
+    std::array<double, 3> frontDepths, rearDepths;
+    for (int j = 0; j < 3; ++j) {
+        frontDepths[j] = std::max(tIn, std::min(chord.third(0, j), branchEntry));
+        rearDepths[j] = std::max(chord.third(1, j), tRear);
+    }
+    addThirds(front, thirds[0], frontDepths);
+    addThirds(rear, thirds[1], rearDepths);
 }
 
 // primitiveEntry of the primitive of cylinder `c` and ball `ball` (cylinderSphere of it).
