@@ -574,8 +574,10 @@ TEST(FaithfulModels, ABoughsShadowIsWhereItsNeedlesCastIt)
     // shadow ray) against each level's. The shadow's error is measured on the light it lets
     // through, as a fraction of the unshadowed bough's: in deep shadow the ratio of two small
     // numbers says little (measured: within 0.03 of the needles' from the camera's side, 0.045
-    // from above, and from behind 0.034-0.052 too little; bounded at 0.06). From behind the
-    // needles let through 0.501 until their ends were open (render.needle_ends), 0.514 since:
+    // from above, and from behind 0.034-0.052 too little; bounded at 0.06; since level 3 lights
+    // each third of its halves by its own points, 2026-12-07, it lets through 0.806, 0.156 and
+    // 0.548 against the needles' 0.819, 0.147 and 0.514: from behind 0.035 too much). From behind
+    // the needles let through 0.501 until their ends were open (render.needle_ends), 0.514 since:
     // the flat ends' light, at the needles' tips, is a larger share of the lit bough's. Levels 2-3
     // shade with the layer model's expected self-shadowing and are dark against the needles when
     // the light comes through the bough (measured 0.933 and 0.917 from behind; 0.94 and 0.934 with
@@ -666,12 +668,6 @@ TEST(FaithfulModels, AFarBoughsShadowSpreadsAsItsPixelsFootprintDoes)
     }
 }
 
-// One long paper bough side-on (LongBough at 90 degrees), lit from straight above, under an
-// opaque rod 0.8 cm in radius running along it 6 cm above, moved 1 cm away from the camera:
-// the rod's shadow falls on the bough's rear half (y 0.2 to 1.8, the needles reaching 1.6 from
-// the axis) and spares its front. The luminance of the bough's rows (z within 3 cm of its
-// axis) with the rod, over that without it, so that what the rod itself shows in the frame is
-// left out.
 // The explicit needles at 16 spp, or the multiscale method forced to `level`.
 RenderResult needlesOrLevel(const TracedScene& traced, bool needles, int level)
 {
@@ -693,6 +689,12 @@ double rowFromAxis_cm(const Image& image, int y)
     return std::abs(y + 0.5 - 0.5 * image.height) / rowsPerCm;
 }
 
+// One long paper bough side-on (LongBough at 90 degrees), lit from straight above, under an
+// opaque rod 0.8 cm in radius running along it 6 cm above, moved 1 cm away from the camera:
+// the rod's shadow falls on the bough's rear half (y 0.2 to 1.8, the needles reaching 1.6 from
+// the axis) and spares its front. The luminance of the bough's rows (z within 3 cm of its
+// axis) with the rod, over that without it, so that what the rod itself shows in the frame is
+// left out.
 double underTheRod(bool rod, int level, unsigned seed, bool needles)
 {
     LongBough bough(90.0, {}, seed, R"("diffuse", "shadows", "self_shadowing")", "[0, 0, 1]");
@@ -716,10 +718,12 @@ TEST(FaithfulModels, ARodsShadowFallsOnTheRearHalfAlone)
     // shadow line at its own depth and level 3 at three points along each half's chord
     // (shadowAcross). Measured 2026-12-05 in LongBough's frame: needles 0.817 (4 rolls); level
     // 2 0.795, level 3 0.796 (in a 160 x 120 frame 6 degrees high: 0.816, 0.801, 0.791).
-    // Since each third of level 3's chord is lit by its own points and composited apart
+    // Since each third of level 3's halves is lit by its own points and composited apart
     // (2026-12-07), the rod darkens the light the law's rear half reflects, where before it
-    // darkened the mean over both halves weighted by what of each is lit: 0.782, as level 2's
-    // layers are darkened (0.795). Bounded at 0.04.
+    // darkened the mean over both halves weighted by what of each is lit: 0.782, further from
+    // the needles and from level 2. No neighbour lies among this bough's needles, so this is
+    // the halves lit apart alone, kept for what it gains on the forests (docs/models.md,
+    // "Whole scenes"). Bounded at 0.04.
     // Without the rod's shadow they would read 1; with a rod over the whole bough, 0
     // (measured: direct light alone). Level 3's points weighted by where the exact law's lit
     // needles lie along the chord (not kept: docs/models.md, "Where along the chord") read, in that
@@ -741,7 +745,7 @@ TEST(FaithfulModels, ARodsShadowFallsOnTheRearHalfAlone)
 }
 
 // One long paper bough side-on (LongBough at 90 degrees), lit from the camera's side, with an
-// opaque rod `radius_cm` thick along it inside its front half, its axis `depth_cm` nearer the
+// opaque rod `radius_cm` in radius along it inside its front half, its axis `depth_cm` nearer the
 // camera than the bough's (the front half's needles reach 1.6 cm towards the camera): the
 // foliage each method shows over the rod's middle rows, where the rod covers the pixels, and
 // the light of the bough's rows (z within 3 cm of its axis), each summed over the frame.
@@ -777,11 +781,13 @@ TEST(FaithfulModels, ARodInsideABoughsFrontHalfHidesTheNeedlesBehindIt)
     // chord (shadow_origin "needles"): the rod hides the thirds behind it. As one fragment a
     // half, at the bough's entry, the whole front half showed over the rod and the rod hid
     // the rear: measured 2026-12-07, the foliage over the rod 3.69 and 2.48 times the
-    // needles' and the bough's light 0.808 and 0.865 of theirs (rod 0.35 cm thick 0.7 cm in
-    // front of the axis, 0.3 cm thick 0.5 cm in front), now 1.23 and 1.65 times and 0.993
-    // and 0.985. The thirds take even shares of the half's opacity, where the needles thin
-    // out away from the axis (their length per volume falls as 1 / rho), so the third in
-    // front of the rod still shows more than the needles there.
+    // needles' and the bough's light (the rod's own included) 0.808 and 0.865 of theirs (rod
+    // 0.35 cm in radius 0.7 cm in front of the axis, 0.3 cm 0.5 cm in front), now 1.23 and
+    // 1.65 times and 0.993 and 0.985. In the second the middle third lies 0.013 cm in front
+    // of the rod: its foliage could read either way, the bound holds both. The thirds take even
+    // shares of the half's opacity, where the needles thin out away from the axis (their length per
+    // volume falls as 1 / rho), so the third in front of the rod still shows more than the needles
+    // there.
     for (const auto& [radius, depth] : {std::pair{0.35, 0.7}, std::pair{0.3, 0.5}}) {
         constexpr int kRolls = 4;
         OverTheRod needles{0.0, 0.0};
@@ -792,7 +798,7 @@ TEST(FaithfulModels, ARodInsideABoughsFrontHalfHidesTheNeedlesBehindIt)
         }
         const OverTheRod m = rodInTheFrontHalf(3, 1, false, radius, depth);
         std::printf(
-            "a rod %.2f cm thick %.1f cm in front of a bough's axis, level 3 against "
+            "a rod %.2f cm in radius %.1f cm in front of a bough's axis, level 3 against "
             "the needles: the foliage over the rod %.3f, the bough's light %.3f\n",
             radius, depth, m.foliage / needles.foliage, m.light / needles.light);
         EXPECT_NEAR(m.light / needles.light, 1.0, 0.03) << radius << " cm at " << depth;
