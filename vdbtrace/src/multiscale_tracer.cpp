@@ -562,8 +562,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
 
     // Level 3: section 6 per light under the bough law, front half at the entry and rear
     // half at the middle (or just behind the bough's own branch where that lies as deep), so
-    // that the branch inside sorts between them; with shadow_origin "needles" and shadows,
-    // each half as three fragments along its chord (below). Each profile is read over the
+    // that the branch inside sorts between them; with shadow_origin "needles", each half as
+    // three fragments along its chord (below). Each profile is read over the
     // footprint at the chord's signed offset from the axis.
     ++mStats.boughHits;
     const double R = b.radius_cm;
@@ -630,8 +630,10 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     // the paper forest, against level 1 at an eighth of its footprints, per tree: -4.0% as two
     // fragments lit by one mean, -3.1% as two each lit by its own thirds, -3.7% as six lit
     // by one mean, -2.5% as six each lit by its own (docs/models.md, "Whole scenes").
+    // Without shadows the thirds are lit alike and still composited apart, so that what a
+    // pixel shows of the foliage does not change with the shadows switch. With them,
     // shadowAcross has set mThirdShadow for each light by the time it is read.
-    const bool byThirds = mPlan.shadowRays && mScene.shadowOrigin == ShadowOrigin::Needles;
+    const bool byThirds = mScene.shadowOrigin == ShadowOrigin::Needles;
     struct Thirds {
         Vec3 diffuse[3], specular[3];  ///< what each third reflects, as the half's share
     } thirds[2];                       ///< front, rear
@@ -675,7 +677,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         // Each third's share of a half's reflectance `f`, lit through its own shadow lines.
         const auto byThird = [&](Vec3(Thirds::*part)[3], int half, const Vec3& f) {
             for (int j = 0; j < 3; ++j) {
-                (thirds[half].*part)[j] += f / 3.0 * mThirdShadow[half][j] * unshadowed;
+                (thirds[half].*part)[j] +=
+                    f / 3.0 * (mPlan.shadowRays ? mThirdShadow[half][j] : 1.0) * unshadowed;
             }
         };
         double f, r;
