@@ -563,8 +563,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     // Level 3: section 6 per light under the bough law, front half at the entry and rear
     // half at the middle (or just behind the bough's own branch where that lies as deep), so
     // that the branch inside sorts between them; with shadow_origin "needles", each half as
-    // three fragments along its chord (below). Each profile is read over the
-    // footprint at the chord's signed offset from the axis.
+    // three fragments along its chord (below). Each profile is read over the footprint at the
+    // chord's signed offset from the axis.
     ++mStats.boughHits;
     const double R = b.radius_cm;
     const std::shared_ptr<const BoughView> kept = b.view();
