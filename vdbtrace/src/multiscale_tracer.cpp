@@ -43,6 +43,22 @@ struct ChordHalves {
     }
 };
 
+// The chord [tIn, tOut] of `ray` through bough `b`, whose axis the ray passes at `p`, in halves.
+ChordHalves chordHalves(const ConeRay& ray, const TracedBough& b, const Passage& p, double tIn,
+                        double tOut)
+{
+    const double tMid = 0.5 * (tIn + tOut);
+    ChordHalves chord{tIn, tMid, tOut, tMid, tMid};
+    const double sinTheta = glm::length(glm::cross(b.axis, ray.direction));
+    if (b.barkRadius_cm > p.gap && sinTheta > 1e-9) {
+        // The bark about the axis, entered and left at p.t -+ its half chord there.
+        const double half = std::sqrt(b.barkRadius_cm * b.barkRadius_cm - p.gap * p.gap) / sinTheta;
+        chord.frontEnd = std::clamp(p.t - half, tIn, tMid);
+        chord.rearStart = std::clamp(p.t + half, tMid, tOut);
+    }
+    return chord;
+}
+
 bool contains(const std::vector<std::uint32_t>& indices, std::uint32_t index)
 {
     return std::find(indices.begin(), indices.end(), index) != indices.end();
@@ -118,10 +134,11 @@ private:
     // neither the paper forest nor the two-bough tests closer to the needles (docs/models.md,
     // "Where along the chord"). `behind` is the opacity the rear half's light lies behind
     // where the law's rear profile does not already hold it (RearComposite::Own: the
-    // front's), else null. Returns the mean over all points; mThirdShadow holds each third's.
+    // front's), else null. Returns the mean over all points, and in `byThird` each third's
+    // (front half, rear; front to back): its points' weighted mean across the strips.
     double shadowAcross(const ConeRay& ray, std::size_t index, std::size_t light,
                         const FrontRearProfile& litShare, const StripProfile* behind, double xi,
-                        double w, const ChordHalves& chord);
+                        double w, const ChordHalves& chord, double (&byThird)[2][3]);
 
     const TracedScene& mScene;
     const EffectsPlan& mPlan;
@@ -154,9 +171,6 @@ private:
     std::vector<Depth> mDepths;  ///< where a bough's lit needles lie: shadowOf
     ShadowSamples mShadowSamples;
     std::vector<double> mPointShadow;  ///< shadowAcross's: each point's transmittance
-    /// shadowAcross's: the light's transmittance to each third of each half's chord (front,
-    /// rear; front to back), its points' weighted mean across the strips.
-    double mThirdShadow[2][3] = {};
 };
 
 double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std::size_t light,
@@ -181,7 +195,7 @@ double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std:
 double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index, std::size_t light,
                                          const FrontRearProfile& litShare,
                                          const StripProfile* behind, double xi, double w,
-                                         const ChordHalves& chord)
+                                         const ChordHalves& chord, double (&byThird)[2][3])
 {
     constexpr int kShadowStrips = 4;
     const double tIn = chord.tIn, tMid = chord.tMid, tOut = chord.tOut;
@@ -221,7 +235,7 @@ double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index, 
     if (!(strip > 0.0) || !(tOut > tIn)) {  // a footprint or a chord of no width: its middle
         mDepths.assign(1, {tMid, 1.0});
         const double T = shadowOf(ray, index, light, tMid);
-        for (auto& half : mThirdShadow) std::fill(std::begin(half), std::end(half), T);
+        for (auto& half : byThird) std::fill(std::begin(half), std::end(half), T);
         return T;
     }
     mShadowSamples.transmittances = &mPointShadow;
@@ -237,7 +251,7 @@ double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index, 
     }
     for (int h = 0; h < 2; ++h) {
         for (int j = 0; j < 3; ++j) {
-            mThirdShadow[h][j] = weight[h][j] > 0.0 ? sum[h][j] / weight[h][j] : T;
+            byThird[h][j] = weight[h][j] > 0.0 ? sum[h][j] / weight[h][j] : T;
         }
     }
     return T;
@@ -600,18 +614,8 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     const auto rearPart = [&](const StripProfile& profile) {
         return rearScale * rearShare(profile);
     };
-    const double tMid = 0.5 * (tIn + tOut);
-    ChordHalves chord{tIn, tMid, tOut, tMid, tMid};
-    if (b.barkRadius_cm > p.gap) {
-        // The bark about the axis, entered and left at p.t -+ its half chord there.
-        const double sinTheta = glm::length(glm::cross(b.axis, ray.direction));
-        if (sinTheta > 1e-9) {
-            const double half =
-                std::sqrt(b.barkRadius_cm * b.barkRadius_cm - p.gap * p.gap) / sinTheta;
-            chord.frontEnd = std::clamp(p.t - half, tIn, tMid);
-            chord.rearStart = std::clamp(p.t + half, tMid, tOut);
-        }
-    }
+    const ChordHalves chord = chordHalves(ray, b, p, tIn, tOut);
+    const double tMid = chord.tMid;
     Fragment front{tIn, frontAlpha, Vec3(0.0), Vec3(0.0), 3, true, b.tree};
     // Behind the branch's fragment, which may lie as deep where the ray misses the branch.
     const double tRear =
@@ -631,8 +635,7 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
     // fragments lit by one mean, -3.1% as two each lit by its own thirds, -3.7% as six lit
     // by one mean, -2.5% as six each lit by its own (docs/models.md, "Whole scenes").
     // Without shadows the thirds are lit alike and still composited apart, so that what a
-    // pixel shows of the foliage does not change with the shadows switch. With them,
-    // shadowAcross has set mThirdShadow for each light by the time it is read.
+    // pixel shows of the foliage does not change with the shadows switch.
     const bool byThirds = mScene.shadowOrigin == ShadowOrigin::Needles;
     struct Thirds {
         Vec3 diffuse[3], specular[3];  ///< what each third reflects, as the half's share
@@ -648,6 +651,7 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
         const BoughLighting& lit = view.lighting[i];
         mLight[i] = mSurfaces.unshadowed(i, ray.origin + tLight * ray.direction);
         const Vec3 unshadowed = mLight[i].irradiance;
+        double thirdShadow[2][3] = {{1.0, 1.0, 1.0}, {1.0, 1.0, 1.0}};  // shadowAcross's
         // Without self-shadowing the whole opacity reflects; with it, the law's transfer.
         const FrontRearProfile& transfer = mPlan.selfShadowing ? lit.transfer : view.alpha;
         const double tf = transfer.front.overFootprint(xi, R, w);
@@ -664,7 +668,7 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
             mLight[i].irradiance *=
                 shadowAcross(ray, index, i, transfer,
                              b.rearComposite == RearComposite::Share ? nullptr : &view.alpha.front,
-                             xi, w, chord);
+                             xi, w, chord, thirdShadow);
         }
         const Vec3& E = mLight[i].irradiance;
         // What each half reflects: the law's sum over its needles, or (the paper's laws) the
@@ -674,32 +678,31 @@ void MultiscaleRayTracer::addBoughAt(const ConeRay& ray, std::size_t index, Leve
             f = b.shadesNeedles ? perNeedle.front.overFootprint(xi, R, w) : tf * frontFace;
             r = b.shadesNeedles ? rearPart(perNeedle.rear) : tr * rearFace;
         };
-        // Each third's share of a half's reflectance `f`, lit through its own shadow lines.
-        const auto byThird = [&](Vec3(Thirds::*part)[3], int half, const Vec3& f) {
+        // What each half reflects, `f` and `r` per unit irradiance, added to its fragment's
+        // `part` or, by thirds, to each third's, lit through its own shadow lines.
+        const auto add = [&](Vec3 Fragment::*part, Vec3(Thirds::*third)[3], const Vec3& f,
+                             const Vec3& r) {
+            if (!byThirds) {
+                front.*part += f * E;
+                rear.*part += r * E;
+                return;
+            }
             for (int j = 0; j < 3; ++j) {
-                (thirds[half].*part)[j] +=
-                    f / 3.0 * (mPlan.shadowRays ? mThirdShadow[half][j] : 1.0) * unshadowed;
+                (thirds[0].*third)[j] += f / 3.0 * thirdShadow[0][j] * unshadowed;
+                (thirds[1].*third)[j] += r / 3.0 * thirdShadow[1][j] * unshadowed;
             }
         };
         double f, r;
         if (mPlan.diffuse) {
             reflected(lit.diffuse, lit.front.diffuse, lit.rear.diffuse, f, r);
-            front.diffuse += f * b.needleAlbedo / kPi * E;
-            rear.diffuse += r * b.needleAlbedo / kPi * E;
-            if (byThirds) {
-                byThird(&Thirds::diffuse, 0, f * b.needleAlbedo / kPi);
-                byThird(&Thirds::diffuse, 1, r * b.needleAlbedo / kPi);
-            }
+            add(&Fragment::diffuse, &Thirds::diffuse, f * b.needleAlbedo / kPi,
+                r * b.needleAlbedo / kPi);
             mStats.diffuseEvaluations += 2;
         }
         if (mPlan.specular) {
             reflected(lit.specular, lit.front.specular, lit.rear.specular, f, r);
-            front.specular += f * b.specularWeight * E;
-            rear.specular += r * b.specularWeight * E;
-            if (byThirds) {
-                byThird(&Thirds::specular, 0, Vec3(f * b.specularWeight));
-                byThird(&Thirds::specular, 1, Vec3(r * b.specularWeight));
-            }
+            add(&Fragment::specular, &Thirds::specular, Vec3(f * b.specularWeight),
+                Vec3(r * b.specularWeight));
             mStats.specularEvaluations += 2;
         }
     }
