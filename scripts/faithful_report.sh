@@ -7,10 +7,11 @@
 # foliage_luminance AOV summed over the foliage AOV summed: what lies behind partly covered
 # pixels does not count), for the whole image and per tree (`vdbtrace diff`, each tree's
 # foliage summed fragment by fragment by each render: the median and the worst tree's bias,
-# and how many trees are off by more than 3%). A 64 spp needles render on another sample pattern (`--sample-seed 1`), measured against
-# the truth like the others, shows what a truth of that many samples would put into those
-# numbers: against 2048 spp, 256 spp needles are within 2.1% on every tree of the forest and
-# 64 spp within 5.4%.
+# and how many trees are off by more than 3%), and the foliage black where the truth's is lit
+# (pixels, 2 x 2 and 4 x 4 blocks: `vdbtrace diff`'s black_foliage). A 64 spp needles render
+# on another sample pattern (`--sample-seed 1`), measured against the truth like the others,
+# shows what a truth of that many samples would put into those numbers: against 2048 spp,
+# 256 spp needles are within 2.1% on every tree of the forest and 64 spp within 5.4%.
 #
 #   bash scripts/faithful_report.sh [DIR]     renders into DIR (default: a temporary folder)
 #
@@ -53,6 +54,12 @@ for key in ("coverage_bias", "luminance_bias"):
     off = sum(abs(x) > 0.03 for x in b)
     print("   per tree %-15s median %+6.1f%%  worst %+6.1f%% (tree %d)  off by >3%%: %d of %d"
           % (key, 100 * statistics.median(b), 100 * worst[key], worst["tree"], off, len(b)))
+black = json.load(open(sys.argv[1])).get("black_foliage", [])
+if black:
+    print("   foliage black where the truth's is lit: "
+          + ", ".join("%d of %d %s" % (s["black"], s["blocks"],
+                                       "pixels" if s["k"] == 1 else "blocks of %dx%d" % (s["k"], s["k"]))
+                      for s in black if s["k"] <= 4))
 PY
 }
 printf '%-14s %-11s %9s %9s %9s %9s\n' scene render coverage vs_truth luminance vs_truth

@@ -9,6 +9,7 @@
 #include "pine/vdbtrace/effects_plan.h"
 #include "pine/vdbtrace/fragment.h"
 #include "pine/vdbtrace/geometry_tracer.h"
+#include "pine/vdbtrace/image_diff.h"
 #include "pine/vdbtrace/layer_model.h"
 #include "pine/vdbtrace/multiscale_tracer.h"
 #include "pine/vdbtrace/needle_layout.h"
@@ -957,6 +958,45 @@ TEST(FaithfulModels, ABoughsBranchHidesItsNeedlesWithinALevelBlend)
     EXPECT_GT(mixed, 300);
     EXPECT_NEAR(within / needles, 1.0, 0.05);
     EXPECT_NEAR(within / without, 1.0, 0.06);
+}
+
+// Issue 9: no bough shadow or bough face black where the needles are lit. The paper's clamped
+// linear law casts solid shadows and, with self-shadowing, darkens level 3 towards black
+// (errata E11); the faithful models must not. Counted on 2 x 2 pixel blocks, a bough's width
+// here, against 64 spp needles (compareImages' blackFoliage): a pixel of needles may be black
+// where the truth's shadow rays passed between needles that a shadow cone reads as their mean.
+// Measured 2026-12-07 at 160 x 120: faithful 0 of 254 blocks, --paper 10 of 257, the needles
+// on another sample pattern 0 of 277.
+TEST(FaithfulModels, NoBoughIsBlackWhereTheNeedlesAreLit)
+{
+    scenes::Scene scene = scenes::parseScene(
+        test::firScene(R"("diffuse", "shadows", "self_shadowing")", 160, 120), "fir.json");
+    const TracedScene traced = buildTracedScene(scene);
+    GeometryOptions g;
+    g.samples = 64;
+    const RenderResult truth = renderGeometry(traced, g);
+    const auto blackBlocks = [&](const RenderResult& r) {
+        const ImageErrors e = compareImages(r.image, truth.image);
+        const ImageErrors::BlackFoliage* twoByTwo = nullptr;
+        for (const ImageErrors::BlackFoliage& b : e.blackFoliage) {
+            if (b.k == 2) twoByTwo = &b;
+        }
+        EXPECT_NE(twoByTwo, nullptr);
+        EXPECT_GT(twoByTwo ? twoByTwo->blocks : 0, 200u);
+        return twoByTwo ? double(twoByTwo->black) / double(twoByTwo->blocks) : 1.0;
+    };
+    g.sampleSeed = 1;
+    const double needles = blackBlocks(renderGeometry(traced, g));
+    const double faithful = blackBlocks(renderMultiscale(traced));
+    scene.render.model = scenes::ModelChoices::paper();
+    const double paper = blackBlocks(renderMultiscale(buildTracedScene(scene)));
+    std::printf(
+        "2 x 2 blocks of foliage black where 64 spp needles are lit: needles %.3f, "
+        "faithful %.3f, the paper's models %.3f\n",
+        needles, faithful, paper);
+    EXPECT_LE(needles, 0.01);
+    EXPECT_LE(faithful, 0.01);
+    EXPECT_GE(paper, 0.03);  // the check sees what it is for
 }
 
 }  // namespace

@@ -144,5 +144,48 @@ TEST(ImageDiffScales, MatchesDownsamplingTheImagesFirst)
     }
 }
 
+// Foliage seen on both images, at a pixel and over blocks: black where the image's own
+// foliage luminance is under a quarter of the reference's, counted only where the reference's
+// foliage is lit (a quarter of its mean or more) and both cover half the block or more.
+TEST(ImageDiff, CountsFoliageBlackWhereTheReferencesIsLit)
+{
+    constexpr int kSide = 8;
+    Image image(kSide, kSide), reference(kSide, kSide);
+    // The foliage AOVs: its coverage, and its own luminance times it.
+    const auto foliage = [](Image& i, int x, int y, double coverage, double own) {
+        const std::size_t at = std::size_t(y) * kSide + x;
+        i.aov("foliage")[at] = float(coverage);
+        i.aov("foliage_luminance")[at] = float(coverage * own);
+    };
+    for (int y = 0; y < kSide; ++y) {
+        for (int x = 0; x < kSide; ++x) {
+            const bool unlit = x < 2 && y < 2;  // in the reference's shadow: black in both
+            const bool black = x >= 4 && x < 6 && y >= 4 && y < 6;  // the image's alone
+            foliage(reference, x, y, 1.0, unlit ? 0.01 : 0.1);
+            foliage(image, x, y, 1.0, unlit ? 0.0 : black ? 0.02 : 0.1);
+        }
+    }
+    foliage(image, 6, 1, 1.0, 0.03);  // darker, not black: over a quarter of 0.1
+    foliage(image, 7, 7, 0.3, 0.0);   // black, but too little of it at one pixel
+    const ImageErrors e = compareImages(image, reference);
+    ASSERT_EQ(e.blackFoliage.size(), 4u);
+    const std::size_t blocks[4] = {59, 15, 4, 1}, black[4] = {4, 1, 0, 0};
+    for (int s = 0; s < 4; ++s) {
+        const ImageErrors::BlackFoliage& b = e.blackFoliage[s];
+        EXPECT_EQ(b.k, kErrorScales[s]);
+        EXPECT_EQ(b.blocks, blocks[s]) << "k = " << b.k;
+        EXPECT_EQ(b.black, black[s]) << "k = " << b.k;
+    }
+    const nlohmann::json j = e.toJson();
+    EXPECT_EQ(j["black_foliage"][0]["black"], 4);
+    EXPECT_NEAR(j["black_foliage"][0]["fraction"].get<double>(), 4.0 / 59.0, 1e-12);
+    // The reference unlit everywhere: nothing to count; either image without the AOVs: none.
+    Image dark = reference;
+    for (float& v : dark.aov("foliage_luminance")) v = 0.0f;
+    EXPECT_EQ(compareImages(image, dark).blackFoliage[0].blocks, 0u);
+    EXPECT_TRUE(compareImages(image, Image(kSide, kSide)).blackFoliage.empty());
+    EXPECT_TRUE(compareImages(Image(kSide, kSide), reference).blackFoliage.empty());
+}
+
 }  // namespace
 }  // namespace pine::vdbtrace

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 namespace pine::vdbtrace {
 namespace {
@@ -11,6 +13,55 @@ namespace {
 constexpr double kUndefined = std::numeric_limits<double>::quiet_NaN();
 
 double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+
+// ImageErrors::blackFoliage of `image` against `reference`.
+std::vector<ImageErrors::BlackFoliage> blackFoliage(const Image& image, const Image& reference)
+{
+    const auto plane = [](const Image& i, const char* name) -> const std::vector<float>* {
+        const auto found = i.aovs.find(name);
+        const std::size_t n = std::size_t(i.width) * std::size_t(i.height);
+        return found != i.aovs.end() && found->second.size() == n ? &found->second : nullptr;
+    };
+    const std::vector<float>* planes[4] = {
+        plane(image, "foliage"), plane(image, "foliage_luminance"), plane(reference, "foliage"),
+        plane(reference, "foliage_luminance")};
+    std::vector<ImageErrors::BlackFoliage> out;
+    if (std::find(std::begin(planes), std::end(planes), nullptr) != std::end(planes)) return out;
+    for (const int k : kErrorScales) {
+        const int bw = image.width / k, bh = image.height / k;
+        if (bw < 1 || bh < 1) continue;
+        // Each plane's block sums; the ratios below do not need their means.
+        std::vector<double> sums[4];
+        for (int p = 0; p < 4; ++p) {
+            sums[p].assign(std::size_t(bw) * std::size_t(bh), 0.0);
+            for (int y = 0; y < bh * k; ++y) {
+                for (int x = 0; x < bw * k; ++x) {
+                    sums[p][std::size_t(y / k) * bw + std::size_t(x / k)] +=
+                        (*planes[p])[std::size_t(y) * image.width + x];
+                }
+            }
+        }
+        const std::vector<double>&coverage = sums[0], &own = sums[1], &truthCoverage = sums[2],
+              &truthOwn = sums[3];
+        const double covered = kBlackFoliageCoverage * k * k;
+        std::vector<std::pair<std::size_t, double>> both;  // the reference's own luminance
+        double mean = 0.0;
+        for (std::size_t i = 0; i < coverage.size(); ++i) {
+            if (!(coverage[i] >= covered && truthCoverage[i] >= covered)) continue;
+            both.emplace_back(i, truthOwn[i] / truthCoverage[i]);
+            mean += both.back().second;
+        }
+        mean /= double(std::max<std::size_t>(both.size(), 1));
+        ImageErrors::BlackFoliage scale{k, 0, 0};
+        for (const auto& [i, truth] : both) {
+            if (!(truth >= kBlackFoliageFraction * mean) || !(truth > 0.0)) continue;
+            ++scale.blocks;
+            if (own[i] / coverage[i] < kBlackFoliageFraction * truth) ++scale.black;
+        }
+        out.push_back(scale);
+    }
+    return out;
+}
 
 // A perceptually ordered ramp: black, blue, green, yellow, white at 0, .25, .5, .75, 1.
 void ramp(double v, float* rgb)
@@ -39,6 +90,13 @@ nlohmann::json ImageErrors::toJson() const
     for (const AtScale& a : byScale) {
         scales.push_back({{"k", a.k}, {"rmse", a.rmse}, {"mae", a.mae}, {"blocks", a.blocks}});
     }
+    nlohmann::json black = nlohmann::json::array();
+    for (const BlackFoliage& b : blackFoliage) {
+        black.push_back({{"k", b.k},
+                         {"blocks", b.blocks},
+                         {"black", b.black},
+                         {"fraction", b.blocks ? double(b.black) / double(b.blocks) : kUndefined}});
+    }
     return {{"rmse", rmse},
             {"by_level", levels},
             {"by_scale", scales},
@@ -47,6 +105,7 @@ nlohmann::json ImageErrors::toJson() const
             {"relative_floor", relativeFloor},
             {"pixels", pixels},
             {"relative_pixels", relativePixels},
+            {"black_foliage", black},
             {"quantity", "linear luminance of premultiplied RGB"}};
 }
 
@@ -156,6 +215,7 @@ ImageErrors compareImages(const Image& image, const Image& reference, const std:
         const std::size_t blocks = std::size_t(bw) * std::size_t(bh);
         e.byScale.push_back({k, std::sqrt(sq / double(blocks)), abs / double(blocks), blocks});
     }
+    e.blackFoliage = blackFoliage(image, reference);
     e.pixels = n;
     e.rmse = std::sqrt(sumSq / double(std::max<std::size_t>(n, 1)));
     e.meanRelative = e.relativePixels ? sumRelative / double(e.relativePixels) : kUndefined;

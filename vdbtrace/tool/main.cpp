@@ -1338,8 +1338,19 @@ int diff(const fs::path& a, const fs::path& b, const fs::path& outDir, double sc
     } else {
         meanRelative << errors.meanRelative;
     }
+    std::ostringstream black;
+    for (const vdbtrace::ImageErrors::BlackFoliage& atK : errors.blackFoliage) {
+        if (atK.k > 4) break;  // beyond a bough's width
+        black << (atK.k == 1 ? "; foliage black where the reference's is lit: " : ", ") << atK.black
+              << " of " << atK.blocks;
+        if (atK.k == 1) {
+            black << " pixels";
+        } else {
+            black << " blocks of " << atK.k << "x" << atK.k;
+        }
+    }
     std::cerr << "vdbtrace diff: rmse " << errors.rmse << ", mean relative " << meanRelative.str()
-              << ", max " << errors.maxAbsolute << worst << " -> " << outDir.string()
+              << ", max " << errors.maxAbsolute << worst << black.str() << " -> " << outDir.string()
               << " (error.exr, error.png scaled 0.." << shown << ", errors.json)\n";
     return 0;
 }

@@ -37,6 +37,22 @@ struct ImageErrors {
     };
     /// At each of kErrorScales that leaves at least one whole block, in that order.
     std::vector<AtScale> byScale;
+    /// Foliage black where the reference's is lit (issue 9: no bough shadow or bough face black
+    /// where the truth is not; the paper's clamped laws cast solid black shadows), after
+    /// box-downsampling both images' "foliage" and "foliage_luminance" AOVs by k. Over the
+    /// blocks where both images' foliage covers at least kBlackFoliageCoverage and the
+    /// reference's own foliage luminance (foliage_luminance / foliage) is at least
+    /// kBlackFoliageFraction of its mean over them (`blocks`): those where the image's own
+    /// foliage luminance is below kBlackFoliageFraction of the reference's (`black`). A pixel
+    /// of needles may be black where the truth's shadow rays passed between the needles a
+    /// shadow cone reads as their mean; a few pixels' block, a bough's width, may not.
+    struct BlackFoliage {
+        int k = 1;
+        std::size_t blocks = 0, black = 0;
+    };
+    /// At each of kErrorScales that leaves a whole block, in that order; empty unless both
+    /// images have both AOVs.
+    std::vector<BlackFoliage> blackFoliage;
     /// The entry of byScale at k, or null.
     const AtScale* atScale(int k) const;
     nlohmann::json toJson() const;
@@ -44,6 +60,11 @@ struct ImageErrors {
 
 /// The box-downsampling factors ImageErrors::byScale is measured at.
 inline constexpr int kErrorScales[] = {1, 2, 4, 8, 16};
+/// ImageErrors::BlackFoliage's: the foliage coverage a pixel needs, and the fraction of the
+/// reference's foliage luminance below which foliage counts as unlit (the reference's) or black
+/// (the image's). A quarter: far below the spread of lit foliage, far above what a solid
+/// shadow lets through.
+inline constexpr double kBlackFoliageCoverage = 0.5, kBlackFoliageFraction = 0.25;
 
 /// Throws ImageError if the sizes differ, if the two are crops of different windows of a frame
 /// (Image::originX...), or if either has a colour that is not finite (NaN or infinity: no
