@@ -56,9 +56,9 @@ for key in ("coverage_bias", "luminance_bias"):
           % (key, 100 * statistics.median(b), 100 * worst[key], worst["tree"], off, len(b)))
 black = json.load(open(sys.argv[1])).get("black_foliage", [])
 if black:
+    where = lambda k: "pixels" if k == 1 else "blocks of %dx%d" % (k, k)
     print("   foliage black where the truth's is lit: "
-          + ", ".join("%d of %d %s" % (s["black"], s["blocks"],
-                                       "pixels" if s["k"] == 1 else "blocks of %dx%d" % (s["k"], s["k"]))
+          + ", ".join("%d of %d %s" % (s["black"], s["blocks"], where(s["k"]))
                       for s in black if s["k"] <= 4))
 PY
 }

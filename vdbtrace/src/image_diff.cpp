@@ -41,8 +41,10 @@ std::vector<ImageErrors::BlackFoliage> blackFoliage(const Image& image, const Im
                 }
             }
         }
-        const std::vector<double>&coverage = sums[0], &own = sums[1], &truthCoverage = sums[2],
-              &truthOwn = sums[3];
+        const std::vector<double>& coverage = sums[0];
+        const std::vector<double>& own = sums[1];
+        const std::vector<double>& truthCoverage = sums[2];
+        const std::vector<double>& truthOwn = sums[3];
         const double covered = kBlackFoliageCoverage * k * k;
         std::vector<std::pair<std::size_t, double>> both;  // the reference's own luminance
         double mean = 0.0;
