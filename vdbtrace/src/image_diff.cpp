@@ -14,37 +14,48 @@ constexpr double kUndefined = std::numeric_limits<double>::quiet_NaN();
 
 double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
 
-// ImageErrors::blackFoliage of `image` against `reference`.
-std::vector<ImageErrors::BlackFoliage> blackFoliage(const Image& image, const Image& reference)
+// `image`'s AOV `name`, or null if it has none of its size.
+const std::vector<float>* aovOrNull(const Image& image, const char* name)
 {
-    const auto plane = [](const Image& i, const char* name) -> const std::vector<float>* {
-        const auto found = i.aovs.find(name);
-        const std::size_t n = std::size_t(i.width) * std::size_t(i.height);
-        return found != i.aovs.end() && found->second.size() == n ? &found->second : nullptr;
-    };
-    const std::vector<float>* planes[4] = {
-        plane(image, "foliage"), plane(image, "foliage_luminance"), plane(reference, "foliage"),
-        plane(reference, "foliage_luminance")};
-    std::vector<ImageErrors::BlackFoliage> out;
-    if (std::find(std::begin(planes), std::end(planes), nullptr) != std::end(planes)) return out;
-    for (const int k : kErrorScales) {
-        const int bw = image.width / k, bh = image.height / k;
-        if (bw < 1 || bh < 1) continue;
-        // Each plane's block sums; the ratios below do not need their means.
-        std::vector<double> sums[4];
-        for (int p = 0; p < 4; ++p) {
-            sums[p].assign(std::size_t(bw) * std::size_t(bh), 0.0);
-            for (int y = 0; y < bh * k; ++y) {
-                for (int x = 0; x < bw * k; ++x) {
-                    sums[p][std::size_t(y / k) * bw + std::size_t(x / k)] +=
-                        (*planes[p])[std::size_t(y) * image.width + x];
+    const auto found = image.aovs.find(name);
+    const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
+    return found != image.aovs.end() && found->second.size() == n ? &found->second : nullptr;
+}
+
+// The sum over each whole k x k block of `plane` (`width` values a row), block by block in
+// rows; a partial block at the right or bottom edge is left out.
+template <class T>
+std::vector<double> blockSums(const std::vector<T>& plane, int width, int height, int k)
+{
+    const int bw = width / k, bh = height / k;
+    std::vector<double> sums(std::size_t(std::max(bw, 0)) * std::size_t(std::max(bh, 0)), 0.0);
+    for (int by = 0; by < bh; ++by) {
+        for (int bx = 0; bx < bw; ++bx) {
+            double& sum = sums[std::size_t(by) * std::size_t(bw) + std::size_t(bx)];
+            for (int y = by * k; y < (by + 1) * k; ++y) {
+                for (int x = bx * k; x < (bx + 1) * k; ++x) {
+                    sum += plane[std::size_t(y) * std::size_t(width) + std::size_t(x)];
                 }
             }
         }
-        const std::vector<double>& coverage = sums[0];
-        const std::vector<double>& own = sums[1];
-        const std::vector<double>& truthCoverage = sums[2];
-        const std::vector<double>& truthOwn = sums[3];
+    }
+    return sums;
+}
+
+// ImageErrors::blackFoliage of `image` against `reference`.
+std::vector<ImageErrors::BlackFoliage> blackFoliage(const Image& image, const Image& reference)
+{
+    const std::vector<float>* planes[4] = {
+        aovOrNull(image, "foliage"), aovOrNull(image, "foliage_luminance"),
+        aovOrNull(reference, "foliage"), aovOrNull(reference, "foliage_luminance")};
+    std::vector<ImageErrors::BlackFoliage> out;
+    if (std::find(std::begin(planes), std::end(planes), nullptr) != std::end(planes)) return out;
+    for (const int k : kErrorScales) {
+        if (image.width / k < 1 || image.height / k < 1) continue;
+        // The ratios below do not need the blocks' means.
+        const auto sums = [&](int p) { return blockSums(*planes[p], image.width, image.height, k); };
+        const std::vector<double> coverage = sums(0), own = sums(1), truthCoverage = sums(2),
+                                  truthOwn = sums(3);
         const double covered = kBlackFoliageCoverage * k * k;
         std::vector<std::pair<std::size_t, double>> both;  // the reference's own luminance
         double mean = 0.0;
@@ -159,8 +170,8 @@ ImageErrors compareImages(const Image& image, const Image& reference, const std:
     meanRef /= double(std::max<std::size_t>(n, 1));
     e.relativeFloor = 0.01 * meanRef;
     double sumRelative = 0.0;
-    const auto levelAov = image.aovs.find("level");
-    const bool hasLevels = levelAov != image.aovs.end() && levelAov->second.size() == n;
+    const std::vector<float>* levels = aovOrNull(image, "level");
+    const bool hasLevels = levels != nullptr;
     std::vector<double> levelSq(4, 0.0), levelRel(4, 0.0);
     std::vector<double> signedError(n);  // for the scales below
     if (hasLevels) e.byLevel.resize(4);
@@ -182,7 +193,7 @@ ImageErrors compareImages(const Image& image, const Image& reference, const std:
             ++e.relativePixels;
         }
         if (hasLevels) {
-            const int k = std::clamp(int(std::lround(levelAov->second[i])), 0, 3);
+            const int k = std::clamp(int(std::lround((*levels)[i])), 0, 3);
             levelSq[k] += d * d;
             ++e.byLevel[k].pixels;
             if (relative) {
@@ -198,23 +209,15 @@ ImageErrors compareImages(const Image& image, const Image& reference, const std:
     }
     // Luminance is linear in RGB, so a block's mean error is the error of the blocks' means.
     for (const int k : kErrorScales) {
-        const int bw = image.width / k, bh = image.height / k;
-        if (bw < 1 || bh < 1) continue;
+        if (image.width / k < 1 || image.height / k < 1) continue;
         double sq = 0.0, abs = 0.0;
-        for (int by = 0; by < bh; ++by) {
-            for (int bx = 0; bx < bw; ++bx) {
-                double sum = 0.0;
-                for (int y = by * k; y < (by + 1) * k; ++y) {
-                    for (int x = bx * k; x < (bx + 1) * k; ++x) {
-                        sum += signedError[std::size_t(y) * image.width + x];
-                    }
-                }
-                const double mean = sum / double(k * k);
-                sq += mean * mean;
-                abs += std::abs(mean);
-            }
+        const std::vector<double> sums = blockSums(signedError, image.width, image.height, k);
+        for (const double sum : sums) {
+            const double mean = sum / double(k * k);
+            sq += mean * mean;
+            abs += std::abs(mean);
         }
-        const std::size_t blocks = std::size_t(bw) * std::size_t(bh);
+        const std::size_t blocks = sums.size();
         e.byScale.push_back({k, std::sqrt(sq / double(blocks)), abs / double(blocks), blocks});
     }
     e.blackFoliage = blackFoliage(image, reference);
