@@ -196,6 +196,10 @@ TEST(SceneParser, ModelsAreFaithfulUnlessThePresetOrAKeySaysOtherwise)
     EXPECT_EQ(paper.extinctionLaw, "layer");
     EXPECT_EQ(paper.shadowOrigin, "axis");
     EXPECT_EQ(paper.levelBlend, 1.0);
+    // One cone a pixel for the paper; the faithful render splits a pixel whose footprint spans
+    // more than one cone spacing at a bough.
+    EXPECT_EQ(faithful.pixelSplitQ, 0.5);
+    EXPECT_EQ(paper.pixelSplitQ, 0.0);
     // A key after the preset overrides it alone.
     j["render"]["layer_model"] = "fibre";
     const ModelChoices mixed = parseScene(j.dump(), "m.json").render.model;
@@ -439,6 +443,7 @@ TEST(SceneParser, RejectsNegativeAndZeroSizes)
         {{"species", "fir", "bark_albedo"}, 1.5},
         {{"species", "fir", "specular_exponent"}, 1},
         {{"render", "cone_level_max"}, 0.1},
+        {{"render", "pixel_split_q"}, -1},
     };
     for (const auto& [place, value] : bad) {
         json j = fullScene();

@@ -440,6 +440,7 @@ ratio = j["multiscale"]["cpu_seconds"] / j["geometry"]["cpu_seconds"]
 assert math.isclose(j["cpu_ratio_multiscale_over_geometry"], ratio, rel_tol=1e-12), ratio
 assert j["multiscale"]["model"]["bough_law"] == "exact", j["multiscale"]["model"]
 assert abs(sum(j["multiscale"]["pixel_share"].values()) - 1) < 1e-9
+assert j["multiscale"]["cones_per_pixel"] >= 1, j["multiscale"]  # split pixels trace more
 assert j["resolution"] == [48, 36] and j["startup_cpu_seconds"] > 0
 # The printed lines say the JSON's numbers (6 significant digits).
 printed = dict(line.rsplit(" ", 1) for line in out.splitlines() if line.startswith("CPU ratio"))

@@ -11,13 +11,15 @@
 
 #include "test_scenes.h"
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -37,6 +39,15 @@ RenderResult render(const std::string& json, int forceLevel = 0)
     MultiscaleOptions options;
     options.forceLevel = forceLevel;
     return renderMultiscale(traced, options);
+}
+
+// The fir with render.pixel_split_q set (its other render keys kept).
+std::string splitFir(int width, int height, double splitQ)
+{
+    nlohmann::json j = nlohmann::json::parse(
+        firScene(R"("diffuse", "specular", "shadows", "self_shadowing")", width, height));
+    j["render"]["pixel_split_q"] = splitQ;
+    return j.dump();
 }
 
 void expectBounded(const Image& image, const std::string& what)
@@ -111,13 +122,73 @@ TEST(MultiscaleTracer, APrimitiveWithNoEntryCouldGiveNoFragment)
 
 TEST(MultiscaleTracer, CompositingStaysBoundedAndUsesEveryLevel)
 {
-    const RenderResult r =
-        render(firScene(R"("diffuse", "specular", "shadows", "self_shadowing")"));
+    // One cone a pixel, so that the fir's footprints call for every level.
+    const RenderResult r = render(splitFir(96, 72, 0.0));
     expectBounded(r.image, "fir");
     EXPECT_GT(r.stats.needleHits, 0u);
     EXPECT_GT(r.stats.coneHits, 0u);
     EXPECT_GT(r.stats.boughHits, 0u);
     EXPECT_EQ(r.stats.coneRays, 96u * 72u);
+    // The faithful default splits the pixels whose footprints span more than half a cone
+    // spacing at a bough.
+    const RenderResult split =
+        render(firScene(R"("diffuse", "specular", "shadows", "self_shadowing")"));
+    expectBounded(split.image, "fir, pixels split");
+    EXPECT_GT(split.stats.coneRays, 96u * 72u);
+}
+
+TEST(MultiscaleTracer, ASplitPixelIsTheMeanOfTheFinerImagesPixels)
+{
+    // With a split threshold below every footprint, each pixel whose cone shows a bough is
+    // traced again as 4 x 4 cones (the most): those of the image 4 times finer, which splits
+    // none. Where the coarse image shows foliage (a bough met, so split), its pixel is their
+    // mean; the other pixels keep their one cone. The tally of each tree's foliage counts the
+    // 16 cones, not the first one too.
+    constexpr int kW = 24, kH = 18, kSplit = scenes::ModelChoices::kMaxPixelSplit;
+    const RenderResult coarse = render(splitFir(kW, kH, 1e-3));
+    const RenderResult fine = render(splitFir(kSplit * kW, kSplit * kH, 0.0));
+    ASSERT_EQ(fine.stats.coneRays, std::uint64_t(kSplit * kW * kSplit * kH));
+    const std::uint64_t extra = coarse.stats.coneRays - std::uint64_t(kW * kH);
+    EXPECT_GT(extra, 0u);
+    EXPECT_EQ(extra % (kSplit * kSplit), 0u) << "each split pixel traces 16 cones more";
+    const std::vector<float>& foliage = coarse.image.aovs.at("foliage");
+    int compared = 0;
+    double worst = 0.0;
+    for (int y = 0; y < kH; ++y) {
+        for (int x = 0; x < kW; ++x) {
+            if (!(foliage[std::size_t(y * kW + x)] > 0.0f)) continue;
+            ++compared;
+            for (int c = 0; c < 4; ++c) {
+                double mean = 0.0;
+                for (int s = 0; s < kSplit * kSplit; ++s) {
+                    mean += fine.image.pixel(kSplit * x + s % kSplit, kSplit * y + s / kSplit)[c];
+                }
+                mean /= kSplit * kSplit;
+                worst = std::max(worst, std::abs(coarse.image.pixel(x, y)[c] - mean) /
+                                            std::max(std::abs(mean), 1e-3));
+            }
+        }
+    }
+    std::printf("%d pixels split, %d with foliage compared; worst relative difference %.2e\n",
+                int(extra / (kSplit * kSplit)), compared, worst);
+    EXPECT_GT(compared, kW * kH / 8);
+    EXPECT_LT(worst, 1e-5);
+    double tallied = 0.0, shown = 0.0;
+    for (const TreeFoliageSum& t : coarse.treeFoliage) tallied += t.coverage_px;
+    for (const float f : foliage) shown += f;
+    EXPECT_NEAR(tallied, shown, 1e-4 * shown);
+}
+
+TEST(MultiscaleTracer, NoPixelIsSplitWhereTheFootprintIsFineOrThePaperAsksOneCone)
+{
+    // The paper's one cone a pixel (pixel_split_q 0), and a threshold above every footprint.
+    EXPECT_EQ(render(splitFir(24, 18, 0.0)).stats.coneRays, 24u * 18u);
+    EXPECT_EQ(render(splitFir(24, 18, 1e3)).stats.coneRays, 24u * 18u);
+    // A forced level is compared at the pixel's own footprint.
+    const scenes::Scene scene = scenes::parseScene(splitFir(24, 18, 1e-3), "test.json");
+    MultiscaleOptions forced;
+    forced.forceLevel = 3;
+    EXPECT_EQ(renderMultiscale(buildTracedScene(scene), forced).stats.coneRays, 24u * 18u);
 }
 
 TEST(MultiscaleTracer, ImageIsTheSameWhateverTheThreadCount)

@@ -49,7 +49,8 @@ std::vector<BudgetSwitch> errorBudgetSwitches(const ModelChoices& scene)
         {"layer_correlation", "multiscale", layerCorrelationNames, &ModelChoices::layerCorrelation},
     };
     const NumberChoice numbers[] = {{"level_blend", &ModelChoices::levelBlend},
-                                    {"cone_level_max", &ModelChoices::coneLevelMax}};
+                                    {"cone_level_max", &ModelChoices::coneLevelMax},
+                                    {"pixel_split_q", &ModelChoices::pixelSplitQ}};
     std::vector<BudgetSwitch> out;
     for (const NamedChoice& c : named) {
         for (const std::string& name : c.names()) {

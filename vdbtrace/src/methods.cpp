@@ -22,7 +22,8 @@ nlohmann::json describeMultiscale(const scenes::Scene& scene, const MethodSettin
             {"bark", scene.render.model.bark},
             {"layer_correlation", scene.render.model.layerCorrelation},
             {"needle_level_max", scene.render.needleLevelMax},
-            {"cone_level_max", scene.render.model.coneLevelMax}};
+            {"cone_level_max", scene.render.model.coneLevelMax},
+            {"pixel_split_q", scene.render.model.pixelSplitQ}};
 }
 
 RenderResult reference(const TracedScene& scene, const MethodSettings& s,

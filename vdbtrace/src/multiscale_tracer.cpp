@@ -76,6 +76,13 @@ public:
     }
 
     void trace(const ConeRay& ray, FrontToBack& composite) override;
+    int pixelSplit() const override
+    {
+        const double qMax = mSettings.model.pixelSplitQ;
+        if (!(qMax > 0.0) || !(mCoarsestQ > qMax)) return 1;
+        return int(
+            std::min(std::ceil(mCoarsestQ / qMax), double(scenes::ModelChoices::kMaxPixelSplit)));
+    }
 
 private:
     double transmittance(const Vec3& x, std::size_t light, double footprint_cm,
@@ -158,6 +165,7 @@ private:
     /// with its own fragments (addBough), which trace() does not draw again.
     std::vector<std::uint32_t> mBranchesMet, mBranchesOfBlends;
     double mTMax = 0.0;  ///< this ray's: where it meets the ground, else infinity
+    double mCoarsestQ = 0.0;  ///< this ray's: the largest footprint / dh of a bough it shaded
     std::vector<LayerHit> mLayerHits;                 ///< a bough's layers on this ray
     std::vector<double> mLayerLit;  ///< their (or level 1's needles') self-shadowing, one light
     std::vector<LayerModel::NeedleOnLine> mNeedlesOnRay;  ///< level 1's, for the layer model
@@ -476,6 +484,7 @@ void MultiscaleRayTracer::addBough(const ConeRay& ray, std::size_t index)
     Passage p;
     if (!closestPassage(ray, b.base_cm, b.conesEnd(), p)) return;
     const double w = ray.width(p.t);
+    mCoarsestQ = std::max(mCoarsestQ, w / b.geometry.coneSpacing_cm);
     if (mForceLevel) return addBoughAt(ray, index, Level(mForceLevel), p);
     const LevelBlend blend = blendLevels(w, b.geometry.coneSpacing_cm, mSettings);
     if (!(blend.upperWeight > 0.0)) return addBoughAt(ray, index, blend.lower, p);
@@ -786,6 +795,7 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     const bool hasGround = hitGround(mScene.scene->ground, ray, tGround, normal);
     const double tMax = hasGround ? tGround : std::numeric_limits<double>::infinity();
     mTMax = tMax;
+    mCoarsestQ = 0.0;
     mBranchesMet.clear();
     mBranchesOfBlends.clear();
     mQueue.clear();
@@ -864,6 +874,11 @@ public:
         }
     }
     int samplesPerPixel() const override { return 1; }
+    /// Forced levels are compared at the pixel's own footprint, as asked.
+    bool splitsPixels() const override
+    {
+        return mScene.scene->render.model.pixelSplitQ > 0.0 && mOptions.forceLevel == 0;
+    }
     ConeRay sample(const ConeCamera& camera, int x, int y, int) const override
     {
         return camera.cone(x, y);

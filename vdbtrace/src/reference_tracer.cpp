@@ -202,8 +202,7 @@ public:
     int samplesPerPixel() const override { return mSubpixels * mSubpixels; }
     ConeRay sample(const ConeCamera& camera, int x, int y, int s) const override
     {
-        const int n = mSubpixels, sx = s % n, sy = s / n;
-        return camera.coneAt(x + (sx + 0.5) / n, y + (sy + 0.5) / n, 1.0 / n);
+        return camera.subpixelCone(x, y, s, mSubpixels);
     }
     std::unique_ptr<RayTracer> rayTracer(RenderStats& stats) const override;
 

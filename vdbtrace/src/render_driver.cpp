@@ -125,6 +125,29 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
     }
     const Aovs aovs(image);
     const int samples = std::max(1, method.samplesPerPixel());
+    const bool split = samples == 1 && method.splitsPixels();
+    // The pixel's cone, then, where its tracer asks, k x k narrower ones in its place; the
+    // first cone's foliage joins the tile's only if it stands.
+    const auto splitPixel = [&](ShadingMethod::RayTracer& tracer, int x, int y, PixelSum& pixel,
+                                TreeFoliageTally& trees, RenderStats& stats) {
+        thread_local TreeFoliageTally first;
+        first.clear();
+        ++stats.coneRays;
+        FrontToBack composite(&first, 1.0);
+        tracer.trace(method.sample(camera, x, y, 0), composite);
+        const int k = tracer.pixelSplit();
+        if (k <= 1) {
+            trees.add(first);
+            pixel.add(composite.value());
+            return;
+        }
+        for (int s = 0; s < k * k; ++s) {
+            ++stats.coneRays;
+            FrontToBack part(&trees, 1.0 / (k * k));
+            tracer.trace(camera.subpixelCone(x, y, s, k), part);
+            pixel.add(part.value());
+        }
+    };
     // Each tile's trees, summed in tile order once all are done.
     std::vector<TreeFoliageTally> tileTrees(
         std::size_t(tileCount(image.width, image.height, options.tileSize)));
@@ -140,11 +163,15 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
             for (int x = tx0 + w.x0; x < tx1 + w.x0; ++x) {
                 const auto t0 = Clock::now();
                 pixel.clear();
-                for (int s = 0; s < samples; ++s) {
-                    ++stats.coneRays;
-                    FrontToBack composite(&trees, 1.0 / samples);
-                    tracer->trace(method.sample(camera, x, y, s), composite);
-                    pixel.add(composite.value());
+                if (split) {
+                    splitPixel(*tracer, x, y, pixel, trees, stats);
+                } else {
+                    for (int s = 0; s < samples; ++s) {
+                        ++stats.coneRays;
+                        FrontToBack composite(&trees, 1.0 / samples);
+                        tracer->trace(method.sample(camera, x, y, s), composite);
+                        pixel.add(composite.value());
+                    }
                 }
                 pixel.write(image, aovs, x - w.x0, y - w.y0);
                 const int dominant = pixel.dominantLevel();

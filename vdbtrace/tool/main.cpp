@@ -100,6 +100,7 @@ struct ModelOverrides {
         needleEnds;
     double levelBlend = 0.0;    ///< 0: the scene's
     double coneLevelMax = 0.0;  ///< 0: the scene's
+    double pixelSplitQ = -1.0;  ///< < 0: the scene's
 
     void add(CLI::App& cmd)
     {
@@ -144,6 +145,11 @@ struct ModelOverrides {
                        "multiscale: level 3 (the bough a volume) from this footprint over cone "
                        "spacing q on, level 2 below; the paper's 1 (render.cone_level_max)")
             ->check(tool::positiveNumber());
+        cmd.add_option("--pixel-split-q", pixelSplitQ,
+                       "multiscale: a pixel whose cone shows a bough at a footprint over cone "
+                       "spacing q above this is traced as k x k narrower cones, k = ceil(q / "
+                       "this) up to 4; 0: one cone a pixel, the paper's (render.pixel_split_q)")
+            ->check(tool::numberIn(0.0, 1e6));
     }
     /// The overrides applied to `render`'s models, then checked against its thresholds as the
     /// scene parser checks the scene's keys. @throw InputError
@@ -160,6 +166,7 @@ struct ModelOverrides {
         if (!layerCorrelation.empty()) m.layerCorrelation = layerCorrelation;
         if (!needleEnds.empty()) m.needleEnds = needleEnds;
         if (coneLevelMax > 0.0) m.coneLevelMax = coneLevelMax;
+        if (pixelSplitQ >= 0.0) m.pixelSplitQ = pixelSplitQ;
         if (!(m.coneLevelMax > render.needleLevelMax)) {
             std::ostringstream message;
             message << "cone_level_max " << m.coneLevelMax
@@ -351,6 +358,7 @@ std::string frameJobDigest(const fs::path& sceneFile, const std::string& methodN
         {"layer_correlation", model.layerCorrelation},
         {"needle_ends", model.needleEnds},
         {"level_blend", model.levelBlend},
+        {"pixel_split_q", model.pixelSplitQ},
         {"cone_level_max", model.coneLevelMax},
         {"resolution", {frame.width, frame.height}},
         {"crop", {frame.crop.x0, frame.crop.y0, frame.crop.x1, frame.crop.y1}},
@@ -969,20 +977,22 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
     const BenchSummary ms = summarize(std::move(methods[0].runs));
     const vdbtrace::RenderResult& r = ms.median.result;
     const auto& st = r.stats;
-    const double pixels = double(st.coneRays);
+    // Pixels by level; a split pixel traces more than one cone (render.pixel_split_q).
+    const double pixels = double(scene.camera.width) * double(scene.camera.height);
     const auto share = [&](int level) { return double(st.pixelsPerLevel[level]) / pixels; };
     std::cout << "scene " << sceneFile.string() << " " << scene.camera.width << "x"
               << scene.camera.height << ", threads " << tbb::this_task_arena::max_concurrency()
               << ", CPU seconds the median of " << repeats << " run(s)"
               << "\nstart-up CPU seconds (libraries loaded, arguments) " << startupCpu
               << "\nscene build seconds (trees grown, BVH; not in the times below) "
-              << ms.median.buildSeconds
-              << "\nmultiscale render: CPU seconds " << ms.median.cpuSeconds << " [" << ms.cpuMin
-              << ", " << ms.cpuMax << "], wall seconds " << ms.median.wallSeconds
+              << ms.median.buildSeconds << "\nmultiscale render: CPU seconds "
+              << ms.median.cpuSeconds << " [" << ms.cpuMin << ", " << ms.cpuMax
+              << "], wall seconds " << ms.median.wallSeconds
               << " (the bough law's profiles included)"
-              << "\ncone rays per second (wall) " << pixels / ms.median.wallSeconds
-              << "\nshare of pixels: none " << share(0) << ", needle " << share(1) << ", cone "
-              << share(2) << ", bough " << share(3) << '\n';
+              << "\ncone rays per second (wall) " << double(st.coneRays) / ms.median.wallSeconds
+              << ", per pixel " << double(st.coneRays) / pixels << "\nshare of pixels: none "
+              << share(0) << ", needle " << share(1) << ", cone " << share(2) << ", bough "
+              << share(3) << '\n';
     const vdbtrace::LawProfileCounts& profiles = ms.median.profiles;
     std::cout << "law profiles: views " << profiles.views.computed << " computed, "
               << profiles.views.dropped << " dropped; from the lights "
@@ -1006,6 +1016,7 @@ int bench(const fs::path& sceneFile, bool scaling, const ModelOverrides& model,
     };
     j["multiscale"] = describeRun(ms);
     j["multiscale"]["model"] = vdbtrace::renderMethod("multiscale").describe(scene, settings);
+    j["multiscale"]["cones_per_pixel"] = double(st.coneRays) / pixels;
     j["multiscale"]["pixel_share"] = {{"none", share(0)}, {"needle", share(1)},
                                       {"cone", share(2)}, {"bough", share(3)}};
     j["multiscale"]["law_profiles"] = {

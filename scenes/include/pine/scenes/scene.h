@@ -110,10 +110,17 @@ struct ModelChoices {
     /// cylinder whose end discs reflect and stop light: the ground truth until 2026-12-07,
     /// kept by the paper preset so that its published images stay reproducible).
     std::string needleEnds = "open";
+    /// The multiscale method's cones per pixel: a pixel whose cone shows a bough at q =
+    /// footprint / dh above this is traced again as k x k cones, each 1/k as wide, k =
+    /// ceil(q / pixelSplitQ) up to kMaxPixelSplit, so that every bough is shaded and
+    /// composited at a footprint of at most this many cone spacings. 0: one cone a pixel, the
+    /// paper's (section 3.2).
+    double pixelSplitQ = 0.5;
+    static constexpr int kMaxPixelSplit = 4;
     /// Every choice as the paper prints it (preset "paper"): today's published behaviour.
     static ModelChoices paper()
     {
-        return {"linear", "paper", "layer", "axis", 1.0, "line", 1.0, "independent", "flat"};
+        return {"linear", "paper", "layer", "axis", 1.0, "line", 1.0, "independent", "flat", 0.0};
     }
     /// The choices that agree with the explicit needles (preset "faithful", the default).
     static ModelChoices faithful() { return {}; }
@@ -122,7 +129,7 @@ struct ModelChoices {
 struct RenderSettings {
     Vec3 background{0.55, 0.7, 0.9};
     /// preset, then bough_law, layer_model, extinction_law, shadow_origin, level_blend, bark,
-    /// cone_level_max, layer_correlation, needle_ends
+    /// cone_level_max, layer_correlation, needle_ends, pixel_split_q
     ModelChoices model;
     /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
     /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):

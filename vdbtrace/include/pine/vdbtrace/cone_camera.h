@@ -18,6 +18,12 @@ public:
     /// The cone through image point (px, py) in pixel units (0..width, 0..height), as wide as
     /// `pixels` pixels: a sub-pixel ray is a narrower cone.
     ConeRay coneAt(double px, double py, double pixels) const;
+    /// Cone s (row-major) of pixel (x, y) split into n x n equal squares, each a cone 1/n as
+    /// wide through its square's centre.
+    ConeRay subpixelCone(int x, int y, int s, int n) const
+    {
+        return coneAt(x + (s % n + 0.5) / n, y + (s / n + 0.5) / n, 1.0 / n);
+    }
     int width() const { return mWidth; }
     int height() const { return mHeight; }
     /// The unit view axis.

@@ -22,6 +22,10 @@ public:
         /// Adds what `ray` meets to `composite`, in front-to-back order, counting into the
         /// stats it was made with.
         virtual void trace(const ConeRay& ray, FrontToBack& composite) = 0;
+        /// After trace() of a pixel's one cone (ShadingMethod::splitsPixels): how many cones
+        /// along each axis its footprint calls for instead, each as wide as its share of the
+        /// pixel; 1: the one cone stands.
+        virtual int pixelSplit() const { return 1; }
     };
 
     virtual ~ShadingMethod() = default;
@@ -30,6 +34,10 @@ public:
     /// Camera ray `s` of pixel (x, y), s in [0, samplesPerPixel()).
     virtual ConeRay sample(const ConeCamera& camera, int x, int y, int s) const = 0;
     virtual std::unique_ptr<RayTracer> rayTracer(RenderStats& stats) const = 0;
+    /// Whether, with one sample a pixel, each pixel's cone is traced first and then, where its
+    /// tracer asks (RayTracer::pixelSplit), replaced by k x k narrower cones: the pixel their
+    /// mean, the first cone's foliage not counted.
+    virtual bool splitsPixels() const { return false; }
 };
 
 /// Renders the scene's camera with `method`: every pixel the mean of its samples' composites

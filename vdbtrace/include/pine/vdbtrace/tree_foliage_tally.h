@@ -38,6 +38,7 @@ public:
     {
         for (const auto& [tree, s] : other.mSums) add(tree, s.coverage_px, s.luminance);
     }
+    void clear() { mSums.clear(); }
     /// By increasing tree index; trees that showed nothing are left out.
     std::vector<TreeFoliageSum> sums() const
     {
