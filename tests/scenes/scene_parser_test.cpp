@@ -197,7 +197,7 @@ TEST(SceneParser, ModelsAreFaithfulUnlessThePresetOrAKeySaysOtherwise)
     EXPECT_EQ(paper.shadowOrigin, "axis");
     EXPECT_EQ(paper.levelBlend, 1.0);
     // One cone a pixel for the paper; the faithful render splits a pixel whose footprint spans
-    // more than one cone spacing at a bough.
+    // more than half a cone spacing at a bough.
     EXPECT_EQ(faithful.pixelSplitQ, 0.5);
     EXPECT_EQ(paper.pixelSplitQ, 0.0);
     // A key after the preset overrides it alone.
