@@ -170,11 +170,10 @@ ImageErrors compareImages(const Image& image, const Image& reference, const std:
     meanRef /= double(std::max<std::size_t>(n, 1));
     e.relativeFloor = 0.01 * meanRef;
     double sumRelative = 0.0;
-    const std::vector<float>* levels = aovOrNull(image, "level");
-    const bool hasLevels = levels != nullptr;
+    const std::vector<float>* levels = aovOrNull(image, "level");  // null: none to split by
     std::vector<double> levelSq(4, 0.0), levelRel(4, 0.0);
     std::vector<double> signedError(n);  // for the scales below
-    if (hasLevels) e.byLevel.resize(4);
+    if (levels) e.byLevel.resize(4);
     for (std::size_t i = 0; i < n; ++i) {
         const float* a = &image.rgba[4 * i];
         const float* b = &reference.rgba[4 * i];
@@ -192,7 +191,7 @@ ImageErrors compareImages(const Image& image, const Image& reference, const std:
             sumRelative += d / ref;
             ++e.relativePixels;
         }
-        if (hasLevels) {
+        if (levels) {
             const int k = std::clamp(int(std::lround((*levels)[i])), 0, 3);
             levelSq[k] += d * d;
             ++e.byLevel[k].pixels;

@@ -126,27 +126,34 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
     const Aovs aovs(image);
     const int samples = std::max(1, method.samplesPerPixel());
     const bool split = samples == 1 && method.splitsPixels();
-    // The pixel's cone, then, where its tracer asks, k x k narrower ones in its place; the
-    // first cone's foliage joins the tile's only if it stands.
+    // n cones of a pixel, cone s given by coneOf(s), each composited alone and a 1/n share of
+    // the pixel and of its trees' foliage.
+    const auto traceCones = [](ShadingMethod::RayTracer& tracer, int n, const auto& coneOf,
+                               PixelSum& pixel, TreeFoliageTally& trees, RenderStats& stats) {
+        for (int s = 0; s < n; ++s) {
+            ++stats.coneRays;
+            FrontToBack composite(&trees, 1.0 / n);
+            tracer.trace(coneOf(s), composite);
+            pixel.add(composite.value());
+        }
+    };
+    // Into the cleared `pixel`: its cone, then, where its tracer asks, k x k narrower ones in
+    // its place; the first cone's foliage joins the tile's only if it stands.
     const auto splitPixel = [&](ShadingMethod::RayTracer& tracer, int x, int y, PixelSum& pixel,
                                 TreeFoliageTally& trees, RenderStats& stats) {
         thread_local TreeFoliageTally first;
         first.clear();
-        ++stats.coneRays;
-        FrontToBack composite(&first, 1.0);
-        tracer.trace(method.sample(camera, x, y, 0), composite);
+        traceCones(
+            tracer, 1, [&](int) { return method.sample(camera, x, y, 0); }, pixel, first, stats);
         const int k = tracer.pixelSplit();
         if (k <= 1) {
             trees.add(first);
-            pixel.add(composite.value());
             return;
         }
-        for (int s = 0; s < k * k; ++s) {
-            ++stats.coneRays;
-            FrontToBack part(&trees, 1.0 / (k * k));
-            tracer.trace(camera.subpixelCone(x, y, s, k), part);
-            pixel.add(part.value());
-        }
+        pixel.clear();
+        traceCones(
+            tracer, k * k, [&](int s) { return camera.subpixelCone(x, y, s, k); }, pixel, trees,
+            stats);
     };
     // Each tile's trees, summed in tile order once all are done.
     std::vector<TreeFoliageTally> tileTrees(
@@ -166,12 +173,9 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
                 if (split) {
                     splitPixel(*tracer, x, y, pixel, trees, stats);
                 } else {
-                    for (int s = 0; s < samples; ++s) {
-                        ++stats.coneRays;
-                        FrontToBack composite(&trees, 1.0 / samples);
-                        tracer->trace(method.sample(camera, x, y, s), composite);
-                        pixel.add(composite.value());
-                    }
+                    traceCones(
+                        *tracer, samples, [&](int s) { return method.sample(camera, x, y, s); },
+                        pixel, trees, stats);
                 }
                 pixel.write(image, aovs, x - w.x0, y - w.y0);
                 const int dominant = pixel.dominantLevel();
