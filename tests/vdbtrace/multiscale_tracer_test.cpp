@@ -139,11 +139,11 @@ TEST(MultiscaleTracer, CompositingStaysBoundedAndUsesEveryLevel)
 
 TEST(MultiscaleTracer, ASplitPixelIsTheMeanOfTheFinerImagesPixels)
 {
-    // With a split threshold below every footprint, each pixel whose cone shows a bough is
+    // With a split threshold below every footprint, each pixel whose square shows a bough is
     // traced again as 4 x 4 cones (the most): those of the image 4 times finer, which splits
-    // none. Where the coarse image shows foliage (a bough met, so split), its pixel is their
-    // mean; the other pixels keep their one cone. The tally of each tree's foliage counts the
-    // 16 cones, not the first one too.
+    // none. Where the finer image shows foliage within the pixel, in its corners alone too
+    // (its own cone's disc misses them), the pixel is their mean; the other pixels keep their
+    // one cone. The tally of each tree's foliage counts the 16 cones, not the first one too.
     constexpr int kW = 24, kH = 18, kSplit = scenes::ModelChoices::kMaxPixelSplit;
     const RenderResult coarse = render(splitFir(kW, kH, 1e-3));
     const RenderResult fine = render(splitFir(kSplit * kW, kSplit * kH, 0.0));
@@ -152,12 +152,21 @@ TEST(MultiscaleTracer, ASplitPixelIsTheMeanOfTheFinerImagesPixels)
     EXPECT_GT(extra, 0u);
     EXPECT_EQ(extra % (kSplit * kSplit), 0u) << "each split pixel traces 16 cones more";
     const std::vector<float>& foliage = coarse.image.aovs.at("foliage");
-    int compared = 0;
+    const std::vector<float>& fineFoliage = fine.image.aovs.at("foliage");
+    const RenderResult one = render(splitFir(kW, kH, 0.0));  // what each pixel's cone meets
+    const std::vector<float>& ownFoliage = one.image.aovs.at("foliage");
+    int compared = 0, byCorners = 0;
     double worst = 0.0;
     for (int y = 0; y < kH; ++y) {
         for (int x = 0; x < kW; ++x) {
-            if (!(foliage[std::size_t(y * kW + x)] > 0.0f)) continue;
+            double within = 0.0;  // the finer image's foliage over the pixel
+            for (int s = 0; s < kSplit * kSplit; ++s) {
+                within += fineFoliage[std::size_t((kSplit * y + s / kSplit) * kSplit * kW +
+                                                  kSplit * x + s % kSplit)];
+            }
+            if (!(foliage[std::size_t(y * kW + x)] > 0.0f) && !(within > 0.0)) continue;
             ++compared;
+            byCorners += ownFoliage[std::size_t(y * kW + x)] > 0.0f ? 0 : 1;
             for (int c = 0; c < 4; ++c) {
                 double mean = 0.0;
                 for (int s = 0; s < kSplit * kSplit; ++s) {
@@ -169,9 +178,12 @@ TEST(MultiscaleTracer, ASplitPixelIsTheMeanOfTheFinerImagesPixels)
             }
         }
     }
-    std::printf("%d pixels split, %d with foliage compared; worst relative difference %.2e\n",
-                int(extra / (kSplit * kSplit)), compared, worst);
+    std::printf(
+        "%d pixels split, %d with foliage compared (%d where the pixel's cone met none); "
+        "worst relative difference %.2e\n",
+        int(extra / (kSplit * kSplit)), compared, byCorners, worst);
     EXPECT_GT(compared, kW * kH / 8);
+    EXPECT_GT(byCorners, 0) << "no pixel showed foliage in its corners alone";
     EXPECT_LT(worst, 1e-5);
     double tallied = 0.0, shown = 0.0;
     for (const TreeFoliageSum& t : coarse.treeFoliage) tallied += t.coverage_px;

@@ -143,9 +143,10 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
                                 TreeFoliageTally& trees, RenderStats& stats) {
         thread_local TreeFoliageTally first;
         first.clear();
+        const ConeRay cone = method.sample(camera, x, y, 0);
         traceCones(
-            tracer, 1, [&](int) { return method.sample(camera, x, y, 0); }, pixel, first, stats);
-        const int k = tracer.pixelSplit();
+            tracer, 1, [&](int) { return cone; }, pixel, first, stats);
+        const int k = tracer.pixelSplit(cone);
         if (k <= 1) {
             trees.add(first);
             return;

@@ -22,10 +22,11 @@ public:
         /// Adds what `ray` meets to `composite`, in front-to-back order, counting into the
         /// stats it was made with.
         virtual void trace(const ConeRay& ray, FrontToBack& composite) = 0;
-        /// After trace() of a pixel's one cone (ShadingMethod::splitsPixels): how many cones
-        /// along each axis its footprint calls for instead, each as wide as its share of the
-        /// pixel; 1: the one cone stands.
-        virtual int pixelSplit() const { return 1; }
+        /// After trace() of a pixel's one cone `pixel` (ShadingMethod::splitsPixels): how many
+        /// cones along each axis the pixel's footprint calls for instead, each as wide as its
+        /// share of the pixel; 1: the one cone stands. The pixel is the square the cone's disc
+        /// is inscribed in: what lies in its corners counts too.
+        virtual int pixelSplit(const ConeRay& /*pixel*/) { return 1; }
     };
 
     virtual ~ShadingMethod() = default;
