@@ -134,9 +134,7 @@ private:
     // one's shadow line passes it (ShadowSamples), so that an occluding bough is averaged over
     // where the needles lie, not read on one line (the explicit needles send a shadow ray from
     // each). Each point also stands where its needles lie along the light, so that an
-    // occluder among them (the bough's own twig) shades only those behind it; and the pixel's
-    // footprint, a disc across the camera ray, spreads the lines across an occluder only as
-    // far as it spreads across that occluder's strip (ShadowSamples::footprintNormal).
+    // occluder among them (the bough's own twig) shades only those behind it.
     double shadowOf(const ConeRay& ray, std::size_t index, std::size_t light, double tRef);
     // Level 3's: the needles of each half of the bough that the light reaches lie across the
     // footprint's share of its strip as the law's transfer `litShare` says (most of them along
@@ -202,7 +200,6 @@ double MultiscaleRayTracer::shadowOf(const ConeRay& ray, std::size_t index, std:
         mShadowSamples.points.push_back(
             {(d.t - tRef) * stretch, d.weight, 0.0, (d.t - tRef) * lift});
     }
-    mShadowSamples.footprintNormal = ray.direction;
     mShadowSamples.transmittances = nullptr;
     return mSurfaces.shadow(light, ray.origin + tRef * ray.direction, ray.width(tRef), index,
                             &mShadowSamples);
@@ -225,7 +222,6 @@ double MultiscaleRayTracer::shadowAcross(const ConeRay& ray, std::size_t index, 
     const Vec3 sideways = glm::cross(L, mShadowSamples.across);
     const double side = glm::length(sideways);
     mShadowSamples.sideways = side > 1e-9 ? sideways / side : Vec3(0.0);
-    mShadowSamples.footprintNormal = ray.direction;
     mShadowSamples.points.clear();
     const double strip = (hi - lo) / kShadowStrips;  // cm across each
     for (int k = 0; k < kShadowStrips && strip > 0.0; ++k) {

@@ -48,9 +48,7 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         const double scale = scene.lights[light].directional ? 1.0 : p.t / tMax;
         const double along = glm::dot(at.across, n) * scale;
         const double aside = glm::dot(at.sideways, n) * scale;
-        // The footprint's width across the occluder's strip (ShadowSamples::footprintNormal).
-        const double tilt = glm::dot(n, at.footprintNormal);
-        const double w = pointWidth * ray.width(p.t) * std::sqrt(std::max(0.0, 1.0 - tilt * tilt));
+        const double w = pointWidth * ray.width(p.t);
         const double R = branch ? scene.branches[index].radius_cm : scene.bough(index).radius_cm;
         // A line farther than this from the axis misses the strip over its footprint: it
         // reads 0 (stripCoverage, StripProfile::overFootprint), kept a hair wide of rounding.

@@ -29,12 +29,6 @@ struct ShadowSamples {
     };
     Vec3 across{0.0}, sideways{0.0};
     std::vector<Point> points;
-    /// Where the footprint is a pixel's, a disc across the camera ray: that ray's direction.
-    /// Each occluder then reads the footprint as wide as the disc spreads across its strip,
-    /// from the whole width to none (an occluder whose strip runs along the camera ray sees
-    /// every line from the disc at one offset: lit from above, a bough seen side-on shades the
-    /// needles of another below it by depth alone). Zero: the whole width across every strip.
-    Vec3 footprintNormal{0.0};
     /// Where shadowConeTransmittance writes each point's own transmittance (one per point, in
     /// their order) besides returning their weighted mean, for samples with points; null:
     /// nowhere.
