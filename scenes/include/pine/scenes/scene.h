@@ -110,8 +110,9 @@ struct ModelChoices {
     /// cylinder whose end discs reflect and stop light: the ground truth until 2026-12-07,
     /// kept by the paper preset so that its published images stay reproducible).
     std::string needleEnds = "open";
-    /// The multiscale method's cones per pixel: a pixel whose cone shows a bough at q =
-    /// footprint / dh above this is traced again as k x k cones, each 1/k as wide, k =
+    /// The multiscale method's cones per pixel: a pixel whose square holds a bough at q =
+    /// footprint / dh above this is traced as k x k cones in place of its one, each 1/k as
+    /// wide, k =
     /// ceil(q / pixelSplitQ) up to kMaxPixelSplit, so that every bough is shaded and
     /// composited at a footprint of at most this many cone spacings. 0: one cone a pixel, the
     /// paper's (section 3.2).
