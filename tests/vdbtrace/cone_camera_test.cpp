@@ -5,6 +5,9 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <random>
 
 namespace pine::vdbtrace {
@@ -56,6 +59,54 @@ TEST(ConeCamera, MatricesProjectEachConeBackToItsImagePosition)
         EXPECT_NEAR(n.y / w, py / c.height, 1e-9);
         EXPECT_NEAR(n.z / w, 1.0 / q.z, 1e-12);
     }
+}
+
+TEST(ConeCamera, APixelsSquareConeHoldsEverySubpixelCone)
+{
+    // The multiscale split asks what the pixel's square holds before choosing k: every cone
+    // of a k x k split must lie within squareCone's disc, its angle from the pixel's axis plus
+    // its own half-angle no more than the square's. Frames from narrow to 150 degrees, every
+    // k the split uses; the pixels include the frame's corners, where the pixel's own cone
+    // widened by sqrt(2) (its disc's rule until 2026-12-07) falls short.
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    double worstMargin = 1.0, sqrt2Short = 0.0;
+    for (int trial = 0; trial < 60; ++trial) {
+        scenes::Camera c;
+        c.position_cm = Vec3(0.0, -100.0, 50.0);
+        c.lookAt_cm = Vec3(unit(random) * 20, 0.0, 40.0 + unit(random) * 20);
+        c.up = Vec3(0, 0, 1);
+        c.fovY_rad = 0.1 + 2.5 * trial / 59.0;  // up to 149 degrees
+        c.width = 16 + 3 * trial;
+        c.height = 12 + trial;
+        const ConeCamera camera(c);
+        for (int corner = 0; corner < 6; ++corner) {
+            const int x = corner < 4 ? (corner % 2) * (c.width - 1) : int(unit(random) * c.width);
+            const int y = corner < 4 ? (corner / 2) * (c.height - 1) : int(unit(random) * c.height);
+            const ConeRay square = camera.squareCone(x, y);
+            const ConeRay pixel = camera.cone(x, y);
+            EXPECT_EQ(square.direction, pixel.direction);
+            const double squareAngle = std::atan(0.5 * square.spread);
+            const double sqrt2Angle = std::atan(0.5 * std::sqrt(2.0) * pixel.spread);
+            for (int k = 2; k <= 4; ++k) {
+                for (int s = 0; s < k * k; ++s) {
+                    const ConeRay sub = camera.subpixelCone(x, y, s, k);
+                    const double reach =
+                        std::acos(std::min(1.0, glm::dot(sub.direction, square.direction))) +
+                        std::atan(0.5 * sub.spread);
+                    ASSERT_LE(reach, squareAngle * (1.0 + 1e-9))
+                        << "fov " << c.fovY_rad << " pixel " << x << "," << y << " k " << k;
+                    worstMargin = std::min(worstMargin, 1.0 - reach / squareAngle);
+                    sqrt2Short = std::max(sqrt2Short, reach / sqrt2Angle - 1.0);
+                }
+            }
+        }
+    }
+    std::printf(
+        "the split's cones stay at least %.1f%% inside the square's disc; the pixel's "
+        "cone widened by sqrt(2) falls %.1f%% short at worst\n",
+        100.0 * worstMargin, 100.0 * sqrt2Short);
+    EXPECT_GT(sqrt2Short, 0.05) << "the wide frames' corners should need more than sqrt(2)";
 }
 
 }  // namespace

@@ -677,6 +677,17 @@ TEST(FaithfulModels, AFarBoughsShadowIsWhereItsNeedlesCastIt)
                     .first;
             };
             const double ratio = lower(false) / lower(true);
+            // needlesShadow's phases: no level depends on them.
+            const double dh = analytic::paperBough().coneSpacing_cm;
+            const auto shifted = [&](bool alone) {
+                return halves(
+                           renderMultiscale(
+                               ShadowedBoughs(towards, 1, alone, true, "32, 24", 0.5 * dh).traced,
+                               m))
+                    .first;
+            };
+            EXPECT_NEAR(shifted(false) / shifted(true), ratio, 1e-3)
+                << towards << " level " << level << ": the phase moved it";
             std::printf("towards [%s] level %d at 1.75 cm a pixel, twigs in: the shadow lets "
                         "through %.4f (needles %.4f)\n",
                         towards.c_str(), level, ratio, through);

@@ -140,8 +140,8 @@ TEST(MultiscaleTracer, CompositingStaysBoundedAndUsesEveryLevel)
 TEST(MultiscaleTracer, ASplitPixelIsTheMeanOfTheFinerImagesPixels)
 {
     // With a split threshold below every footprint, each pixel whose square shows a bough is
-    // traced again as 4 x 4 cones (the most): those of the image 4 times finer, which splits
-    // none. Where the finer image shows foliage within the pixel, in its corners alone too
+    // traced as 4 x 4 cones in place of its one (the most): those of the image 4 times finer, which
+    // splits none. Where the finer image shows foliage within the pixel, in its corners alone too
     // (its own cone's disc misses them), the pixel is their mean; the other pixels keep their
     // one cone. The tally of each tree's foliage counts the 16 cones.
     constexpr int kW = 24, kH = 18, kSplit = scenes::ModelChoices::kMaxPixelSplit;

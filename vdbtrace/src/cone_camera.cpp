@@ -2,7 +2,9 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace pine::vdbtrace {
 
@@ -29,6 +31,19 @@ ConeRay ConeCamera::coneAt(double px, double py, double pixels) const
     // axis. Off axis, at distance len, it subtends p / len across the radial direction and
     // p / len^2 along it (seen obliquely): their geometric mean is the footprint's growth.
     ray.spread = pixels * 2.0 * mTanHalf / mHeight / std::pow(len, 1.5);
+    return ray;
+}
+
+ConeRay ConeCamera::squareCone(int x, int y) const
+{
+    ConeRay ray = cone(x, y);
+    double tanMax = 0.0;  // of the widest angle from the ray to a corner's
+    for (const auto& [cx, cy] : {std::pair{x, y}, {x + 1, y}, {x, y + 1}, {x + 1, y + 1}}) {
+        const Vec3 corner = coneAt(cx, cy, 1.0).direction;
+        const double c = glm::dot(corner, ray.direction);
+        tanMax = std::max(tanMax, std::sqrt(std::max(0.0, 1.0 - c * c)) / c);
+    }
+    ray.spread = 2.0 * tanMax;
     return ray;
 }
 

@@ -76,11 +76,11 @@ public:
     }
 
     void trace(const ConeRay& ray, FrontToBack& composite) override;
-    int pixelSplit(const ConeRay& pixel) override
+    int pixelSplit(const ConeRay& pixel, const ConeRay& square) const override
     {
         const double qMax = mSettings.model.pixelSplitQ;
         if (!(qMax > 0.0)) return 1;
-        const double q = coarsestQ(pixel);
+        const double q = coarsestQ(pixel, square);
         if (!(q > qMax)) return 1;
         return int(std::min(std::ceil(q / qMax), double(scenes::ModelChoices::kMaxPixelSplit)));
     }
@@ -92,14 +92,14 @@ private:
         return shadowConeTransmittance(mScene, x, light, footprint_cm, self, true, samples);
     }
     void addBough(const ConeRay& ray, std::size_t index);
-    // The largest footprint / dh, at the pixel's footprint, of a bough within the disc
-    // through the pixel's corners. Not the pixel's cone's own disc: a bough
-    // in the corners alone left its pixel one cone, its foliage a 1-D box across the strip,
-    // where its neighbours' split cones weigh it by the square (the three firs' far tree lost
-    // 3.2% of its coverage). Boughs hidden behind others or the ground count too, so that the
-    // pixel need not be shaded first to find those it shows (where a corner's cone meets the
-    // ground depends on the ground).
-    double coarsestQ(const ConeRay& pixel);
+    // The largest footprint / dh of a bough within `square`, the disc through the pixel's
+    // corners, each at the pixel's footprint where its segment comes nearest the pixel's
+    // axis. Not the pixel's cone's own disc: a bough in the corners alone left its pixel one
+    // cone, its foliage a 1-D box across the strip, where its neighbours' split cones weigh it
+    // by the square (the three firs' far tree lost 3.2% of its coverage). Boughs hidden
+    // behind others or the ground count too, so that the pixel need not be shaded first to
+    // find those it shows (where a corner's cone meets the ground depends on the ground).
+    double coarsestQ(const ConeRay& pixel, const ConeRay& square) const;
     // The bough's fragments at `level`, the ray passing its needles at `passage` (base to
     // the cones' end).
     // `branchBetween`: the bough's own branch's fragment composites with these fragments, at
@@ -866,14 +866,12 @@ void MultiscaleRayTracer::trace(const ConeRay& ray, FrontToBack& composite)
     compositeBefore(std::numeric_limits<double>::infinity());
 }
 
-double MultiscaleRayTracer::coarsestQ(const ConeRay& pixel)
+double MultiscaleRayTracer::coarsestQ(const ConeRay& pixel, const ConeRay& square) const
 {
-    ConeRay corners = pixel;
-    corners.spread *= std::sqrt(2.0);  // the disc through the square's corners
     const Vec3 &o = pixel.origin, &d = pixel.direction;
     constexpr double tMax = std::numeric_limits<double>::infinity();
     double q = 0.0;
-    mScene.bvh.query(corners, tMax, [&](std::uint32_t index) {
+    mScene.bvh.query(square, tMax, [&](std::uint32_t index) {
         if (mScene.isBranch(index)) return;
         // The capsule about the segment holding its needles, not the capped cylinder that
         // entryInto grows: a narrower cone in the corner may pass beyond the segment's end
@@ -889,7 +887,7 @@ double MultiscaleRayTracer::coarsestQ(const ConeRay& pixel)
         const double t = glm::dot(nearest - o, d);
         const double tBase = glm::dot(c.base - o, d), tEnd = glm::dot(c.end - o, d);
         const double tFar = std::max(tBase, tEnd) + c.radius_cm;
-        const double reach = c.radius_cm + 0.5 * corners.width(std::max(tFar, 0.0));
+        const double reach = c.radius_cm + 0.5 * square.width(std::max(tFar, 0.0));
         if (glm::length(nearest - (o + t * d)) > reach) return;
         q = std::max(q,
                      pixel.width(std::max(t, 0.0)) / mScene.bough(index).geometry.coneSpacing_cm);

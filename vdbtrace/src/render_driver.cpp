@@ -153,7 +153,9 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
                 const auto t0 = Clock::now();
                 pixel.clear();
                 // The pixel's samples or, where its tracer asks, k x k narrower cones.
-                const int side = split ? tracer->pixelSplit(method.sample(camera, x, y, 0)) : 1;
+                const int side = split ? tracer->pixelSplit(method.sample(camera, x, y, 0),
+                                                            camera.squareCone(x, y))
+                                       : 1;
                 if (side > 1) {
                     traceCones(
                         *tracer, side * side,

@@ -111,11 +111,11 @@ struct ModelChoices {
     /// kept by the paper preset so that its published images stay reproducible).
     std::string needleEnds = "open";
     /// The multiscale method's cones per pixel: a pixel whose square holds a bough at q =
-    /// footprint / dh above this is traced as k x k cones in place of its one, each 1/k as
-    /// wide, k =
-    /// ceil(q / pixelSplitQ) up to kMaxPixelSplit, so that every bough is shaded and
-    /// composited at a footprint of at most this many cone spacings. 0: one cone a pixel, the
-    /// paper's (section 3.2).
+    /// footprint / dh above this (q where the bough comes nearest the pixel's axis) is traced
+    /// as k x k cones in place of its one, each 1/k as wide, k = ceil(q / pixelSplitQ) up to
+    /// kMaxPixelSplit, so that the boughs are shaded and composited at footprints of about
+    /// this many cone spacings, up to kMaxPixelSplit times finer than the pixel's. 0: one cone
+    /// a pixel, the paper's (section 3.2).
     double pixelSplitQ = 0.5;
     static constexpr int kMaxPixelSplit = 4;
     /// Every choice as the paper prints it (preset "paper"): today's published behaviour.

@@ -24,6 +24,12 @@ public:
     {
         return coneAt(x + (s % n + 0.5) / n, y + (s / n + 0.5) / n, 1.0 / n);
     }
+    /// The cone through the centre of pixel (x, y) as wide as the disc through its square's
+    /// corners: every subpixelCone of the pixel lies within it, off the view axis too (a
+    /// cone's spread is the geometric mean of the pixel's radial and tangential sizes, so the
+    /// pixel's own cone widened by sqrt(2) falls short of its corners by sqrt(len), len the
+    /// distance to the image plane along its ray: 1.17 at a 4:3 40-degree frame's corner).
+    ConeRay squareCone(int x, int y) const;
     int width() const { return mWidth; }
     int height() const { return mHeight; }
     /// The unit view axis.

@@ -24,9 +24,12 @@ public:
         virtual void trace(const ConeRay& ray, FrontToBack& composite) = 0;
         /// Before a pixel's one cone `pixel` is traced (ShadingMethod::splitsPixels): how many
         /// cones along each axis the pixel calls for in its place, each as wide as its share
-        /// of the pixel; 1: the one cone. The pixel is the square the cone's disc is inscribed
-        /// in: what lies in its corners counts too.
-        virtual int pixelSplit(const ConeRay& /*pixel*/) { return 1; }
+        /// of the pixel; 1: the one cone. `square` is as wide as the disc through the pixel's
+        /// corners (ConeCamera::squareCone): what lies in them counts too.
+        virtual int pixelSplit(const ConeRay& /*pixel*/, const ConeRay& /*square*/) const
+        {
+            return 1;
+        }
     };
 
     virtual ~ShadingMethod() = default;
