@@ -139,19 +139,20 @@ TEST(MultiscaleTracer, CompositingStaysBoundedAndUsesEveryLevel)
 
 TEST(MultiscaleTracer, ASplitPixelIsTheMeanOfTheFinerImagesPixels)
 {
-    // With a split threshold below every footprint, each pixel whose square shows a bough is
-    // traced as 4 x 4 cones in place of its one (the most): those of the image 4 times finer, which
-    // splits none. Where the finer image shows foliage within the pixel, in its corners alone too
-    // (its own cone's disc misses them), the pixel is their mean; the other pixels keep their
-    // one cone. The tally of each tree's foliage counts the 16 cones.
+    // With a split threshold below every footprint, each pixel whose cone shows a bough, or
+    // whose corners alone do, is traced again as 4 x 4 cones (the most): those of the image 4 times
+    // finer, which splits none. Where the finer image shows foliage within the pixel, in its
+    // corners alone too (its own cone's disc misses them), the pixel is their mean; the other
+    // pixels keep their one cone. The tally of each tree's foliage counts the 16 cones, not the
+    // first one too.
     constexpr int kW = 24, kH = 18, kSplit = scenes::ModelChoices::kMaxPixelSplit;
     const RenderResult coarse = render(splitFir(kW, kH, 1e-3));
     const RenderResult fine = render(splitFir(kSplit * kW, kSplit * kH, 0.0));
     ASSERT_EQ(fine.stats.coneRays, std::uint64_t(kSplit * kW * kSplit * kH));
     const std::uint64_t extra = coarse.stats.coneRays - std::uint64_t(kW * kH);
     EXPECT_GT(extra, 0u);
-    constexpr int kMore = kSplit * kSplit - 1;
-    EXPECT_EQ(extra % kMore, 0u) << "each split pixel traces 16 cones in place of its one";
+    constexpr int kMore = kSplit * kSplit;
+    EXPECT_EQ(extra % kMore, 0u) << "each split pixel traces 16 cones more";
     const std::vector<float>& foliage = coarse.image.aovs.at("foliage");
     const std::vector<float>& fineFoliage = fine.image.aovs.at("foliage");
     const RenderResult one = render(splitFir(kW, kH, 0.0));  // what each pixel's cone meets

@@ -137,6 +137,25 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
             pixel.add(composite.value());
         }
     };
+    // Into the cleared `pixel`: its cone, then, where its tracer asks, k x k narrower ones in
+    // its place; the first cone's foliage joins the tile's only if it stands.
+    const auto splitPixel = [&](ShadingMethod::RayTracer& tracer, int x, int y, PixelSum& pixel,
+                                TreeFoliageTally& trees, RenderStats& stats) {
+        thread_local TreeFoliageTally first;
+        first.clear();
+        const ConeRay cone = method.sample(camera, x, y, 0);
+        traceCones(
+            tracer, 1, [&](int) { return cone; }, pixel, first, stats);
+        const int side = tracer.pixelSplit(cone, camera.squareCone(x, y));
+        if (side <= 1) {
+            trees.add(first);
+            return;
+        }
+        pixel.clear();
+        traceCones(
+            tracer, side * side, [&](int s) { return camera.subpixelCone(x, y, s, side); }, pixel,
+            trees, stats);
+    };
     // Each tile's trees, summed in tile order once all are done.
     std::vector<TreeFoliageTally> tileTrees(
         std::size_t(tileCount(image.width, image.height, options.tileSize)));
@@ -152,15 +171,8 @@ RenderResult renderImage(const TracedScene& scene, const ShadingMethod& method,
             for (int x = tx0 + w.x0; x < tx1 + w.x0; ++x) {
                 const auto t0 = Clock::now();
                 pixel.clear();
-                // The pixel's samples or, where its tracer asks, k x k narrower cones.
-                const int side = split ? tracer->pixelSplit(method.sample(camera, x, y, 0),
-                                                            camera.squareCone(x, y))
-                                       : 1;
-                if (side > 1) {
-                    traceCones(
-                        *tracer, side * side,
-                        [&](int s) { return camera.subpixelCone(x, y, s, side); }, pixel, trees,
-                        stats);
+                if (split) {
+                    splitPixel(*tracer, x, y, pixel, trees, stats);
                 } else {
                     traceCones(
                         *tracer, samples, [&](int s) { return method.sample(camera, x, y, s); },

@@ -22,10 +22,10 @@ public:
         /// Adds what `ray` meets to `composite`, in front-to-back order, counting into the
         /// stats it was made with.
         virtual void trace(const ConeRay& ray, FrontToBack& composite) = 0;
-        /// Before a pixel's one cone `pixel` is traced (ShadingMethod::splitsPixels): how many
+        /// After trace() of a pixel's one cone `pixel` (ShadingMethod::splitsPixels): how many
         /// cones along each axis the pixel calls for in its place, each as wide as its share
-        /// of the pixel; 1: the one cone. `square` is as wide as the disc through the pixel's
-        /// corners (ConeCamera::squareCone): what lies in them counts too.
+        /// of the pixel; 1: the one cone stands. `square` is as wide as the disc through the
+        /// pixel's corners (ConeCamera::squareCone), for what lies in them alone.
         virtual int pixelSplit(const ConeRay& /*pixel*/, const ConeRay& /*square*/) const
         {
             return 1;
@@ -38,8 +38,9 @@ public:
     /// Camera ray `s` of pixel (x, y), s in [0, samplesPerPixel()).
     virtual ConeRay sample(const ConeCamera& camera, int x, int y, int s) const = 0;
     virtual std::unique_ptr<RayTracer> rayTracer(RenderStats& stats) const = 0;
-    /// Whether, with one sample a pixel, each pixel's cone is replaced where its tracer asks
-    /// (RayTracer::pixelSplit) by k x k narrower cones: the pixel their mean.
+    /// Whether, with one sample a pixel, each pixel's cone is traced first and then, where its
+    /// tracer asks (RayTracer::pixelSplit), replaced by k x k narrower cones: the pixel their
+    /// mean, the first cone's foliage not counted.
     virtual bool splitsPixels() const { return false; }
 };
 
