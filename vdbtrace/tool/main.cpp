@@ -146,9 +146,10 @@ struct ModelOverrides {
                        "spacing q on, level 2 below; the paper's 1 (render.cone_level_max)")
             ->check(tool::positiveNumber());
         cmd.add_option("--pixel-split-q", pixelSplitQ,
-                       "multiscale: a pixel whose square holds a bough at a footprint over cone "
-                       "spacing q above this is traced as k x k narrower cones, k = ceil(q / "
-                       "this) up to 4; 0: one cone a pixel, the paper's (render.pixel_split_q)")
+                       "multiscale: a pixel whose cone (or corners) shows a bough at a footprint "
+                       "over cone spacing q above this is traced as k x k narrower cones, k = "
+                       "ceil(q / this) up to 4; 0: one cone a pixel, the paper's "
+                       "(render.pixel_split_q)")
             ->check(tool::numberIn(0.0, 1e6));
     }
     /// The overrides applied to `render`'s models, then checked against its thresholds as the

@@ -110,9 +110,9 @@ struct ModelChoices {
     /// cylinder whose end discs reflect and stop light: the ground truth until 2026-12-07,
     /// kept by the paper preset so that its published images stay reproducible).
     std::string needleEnds = "open";
-    /// The multiscale method's cones per pixel: a pixel whose square holds a bough at q =
-    /// footprint / dh above this (q where the bough comes nearest the pixel's axis) is traced
-    /// as k x k cones in place of its one, each 1/k as wide, k = ceil(q / pixelSplitQ) up to
+    /// The multiscale method's cones per pixel: a pixel whose cone shows a bough at q =
+    /// footprint / dh above this (where it shows none, whose corners do) is traced again as
+    /// k x k cones, each 1/k as wide, k = ceil(q / pixelSplitQ) up to
     /// kMaxPixelSplit, so that the boughs are shaded and composited at footprints of about
     /// this many cone spacings, up to kMaxPixelSplit times finer than the pixel's. 0: one cone
     /// a pixel, the paper's (section 3.2).
