@@ -152,6 +152,8 @@ exr_info "$work/b.exr" >"$work/info"
 grep -q "channel list: R, G, B, A, Z, diffuse.Y, foliage.Y, foliage_luminance.Y, level.Y, specular.Y, tree.Y" "$work/info" \
     || fail "multiscale EXR channels: $(grep 'channel list' "$work/info")"
 grep -q "samplesPerPixel: 1$" "$work/info" || fail "multiscale EXR lacks samplesPerPixel 1"
+# bough.json is a close-up: no pixel of it is split, one cone each.
+grep -q "pine:cones_per_pixel: 1$" "$work/info" || fail "multiscale EXR lacks pine:cones_per_pixel 1: $(grep cones_per_pixel "$work/info")"
 grep -q "renderTimeSeconds: [0-9.e-]*$" "$work/info" || fail "EXR lacks a float renderTimeSeconds"
 grep -q "worldToCamera: " "$work/info" && grep -q "worldToNDC: " "$work/info" || fail "EXR lacks camera matrices"
 # OpenEXR's convention (row vectors): the camera's position maps to the origin, p M = 0, and

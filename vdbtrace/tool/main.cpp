@@ -700,6 +700,11 @@ int render(const fs::path& sceneFile, const std::string& methodName, const fs::p
                                          {"pine:ranks", ranks.size()},
                                          {"pine:effects", effects.dump()},
                                          {"pine:units", "cm"}});
+        // samplesPerPixel is the method's per pixel; the multiscale split traces more where
+        // its pixels ask (render.pixel_split_q): the mean over this image.
+        const double pixels = double(result.image.width) * double(result.image.height);
+        metadata.emplace_back("pine:cones_per_pixel",
+                              float(pixels > 0.0 ? double(result.stats.coneRays) / pixels : 0.0));
         if (f) {
             metadata.emplace_back("pine:frame", *f);
             metadata.emplace_back("pine:fps", float(path.framesPerSecond));
