@@ -671,22 +671,17 @@ TEST(FaithfulModels, AFarBoughsShadowIsWhereItsNeedlesCastIt)
         for (const int level : {2, 3}) {
             MultiscaleOptions m;
             m.forceLevel = level;
-            const auto lower = [&](bool alone) {
-                return halves(renderMultiscale(
-                                  ShadowedBoughs(towards, 1, alone, true, "32, 24").traced, m))
-                    .first;
-            };
-            const double ratio = lower(false) / lower(true);
-            // needlesShadow's phases: no level depends on them.
-            const double dh = analytic::paperBough().coneSpacing_cm;
-            const auto shifted = [&](bool alone) {
+            const auto lower = [&](bool alone, double shift_cm) {
                 return halves(
                            renderMultiscale(
-                               ShadowedBoughs(towards, 1, alone, true, "32, 24", 0.5 * dh).traced,
+                               ShadowedBoughs(towards, 1, alone, true, "32, 24", shift_cm).traced,
                                m))
                     .first;
             };
-            EXPECT_NEAR(shifted(false) / shifted(true), ratio, 1e-3)
+            const double ratio = lower(false, 0.0) / lower(true, 0.0);
+            // needlesShadow's phases: no level depends on them.
+            const double half = 0.5 * analytic::paperBough().coneSpacing_cm;
+            EXPECT_NEAR(lower(false, half) / lower(true, half), ratio, 1e-3)
                 << towards << " level " << level << ": the phase moved it";
             std::printf("towards [%s] level %d at 1.75 cm a pixel, twigs in: the shadow lets "
                         "through %.4f (needles %.4f)\n",
