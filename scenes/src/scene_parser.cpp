@@ -224,6 +224,7 @@ RenderSettings readRender(const Json& value, const Where& where)
     s.model.layerCorrelation = r.string("layer_correlation", s.model.layerCorrelation);
     s.model.needleEnds = r.string("needle_ends", s.model.needleEnds);
     s.model.pixelSplitQ = r.number("pixel_split_q", Range::atLeast(0), s.model.pixelSplitQ);
+    s.model.occluderProfile = r.string("occluder_profile", s.model.occluderProfile);
     s.needleLevelMax = r.number("needle_level_max", Range::above(0), s.needleLevelMax);
     s.model.coneLevelMax = r.number("cone_level_max", Range::above(0), s.model.coneLevelMax);
     if (!(s.model.coneLevelMax > s.needleLevelMax)) {

@@ -205,6 +205,12 @@ TEST(SceneParser, ModelsAreFaithfulUnlessThePresetOrAKeySaysOtherwise)
     const ModelChoices mixed = parseScene(j.dump(), "m.json").render.model;
     EXPECT_EQ(mixed.boughLaw, "linear");
     EXPECT_EQ(mixed.layerModel, "fibre");
+    // Occluding boughs read where their cones reach, or even along the axis as printed.
+    EXPECT_EQ(faithful.occluderProfile, "cones");
+    EXPECT_EQ(paper.occluderProfile, "even");
+    j["render"]["occluder_profile"] = "cones";
+    EXPECT_EQ(parseScene(j.dump(), "m.json").render.model.occluderProfile, "cones");
+    j["render"].erase("occluder_profile");
     // The level 3 threshold is one of the choices: the preset's unless the scene names it.
     EXPECT_EQ(faithful.coneLevelMax, 1.0);
     EXPECT_EQ(mixed.coneLevelMax, 1.0);

@@ -347,6 +347,8 @@ expect_error "a band too wide for the thresholds" 2 "--level-blend 2 must be at 
     render "$src/scenes/bough.json" --level-blend 2 --cone-level-max 0.3 --out "$work/n2.exr"
 grep -q '"layer_correlation": "needles"' "$work/b.json" || fail "default layer correlation not recorded as needles"
 grep -q '"layer_correlation": "independent"' "$work/p.json" || fail "--paper did not make the layers independent"
+grep -q '"occluder_profile": "cones"' "$work/b.json" || fail "default occluder profile not recorded as cones"
+grep -q '"occluder_profile": "even"' "$work/p.json" || fail "--paper did not read the occluders even"
 "$vdbtrace" render "$src/scenes/bough.json" --paper --layer-model fibre --out "$work/p.exr" --stats "$work/p.json" 2>/dev/null \
     || fail "render --paper --layer-model fibre failed"
 grep -q '"layer_model": "fibre"' "$work/p.json" || fail "--layer-model did not override --paper"

@@ -509,6 +509,13 @@ TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
     expectInputError([&] { buildTracedScene(scene); },
                      "fir.json: render.needle_ends: unknown needle ends 'round' (known: open, "
                      "flat)");
+    EXPECT_EQ(occluderProfileNames().front(), scenes::ModelChoices{}.occluderProfile);
+    EXPECT_EQ(scenes::ModelChoices::paper().occluderProfile, "even");
+    scene.render.model = {};
+    scene.render.model.occluderProfile = "ends";
+    expectInputError([&] { buildTracedScene(scene); },
+                     "fir.json: render.occluder_profile: unknown occluder profile 'ends' (known: "
+                     "cones, even)");
 }
 
 TEST(MultiscaleTracer, ConeLevelCrossesTheTrueCones)

@@ -47,6 +47,7 @@ std::vector<BudgetSwitch> errorBudgetSwitches(const ModelChoices& scene)
         {"shadow_origin", "multiscale", shadowOriginNames, &ModelChoices::shadowOrigin},
         {"bark", "multiscale", barkNames, &ModelChoices::bark},
         {"layer_correlation", "multiscale", layerCorrelationNames, &ModelChoices::layerCorrelation},
+        {"occluder_profile", "multiscale", occluderProfileNames, &ModelChoices::occluderProfile},
     };
     const NumberChoice numbers[] = {{"level_blend", &ModelChoices::levelBlend},
                                     {"cone_level_max", &ModelChoices::coneLevelMax},

@@ -21,6 +21,7 @@ nlohmann::json describeMultiscale(const scenes::Scene& scene, const MethodSettin
             {"level_blend", scene.render.model.levelBlend},
             {"bark", scene.render.model.bark},
             {"layer_correlation", scene.render.model.layerCorrelation},
+            {"occluder_profile", scene.render.model.occluderProfile},
             {"needle_level_max", scene.render.needleLevelMax},
             {"cone_level_max", scene.render.model.coneLevelMax},
             {"pixel_split_q", scene.render.model.pixelSplitQ}};

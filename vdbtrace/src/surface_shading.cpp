@@ -3,6 +3,7 @@
 #include "pine/analytic/needle_shader.h"
 #include "pine/vdbtrace/ground_hit.h"
 #include "pine/vdbtrace/light_columns.h"
+#include "pine/vdbtrace/occluder_profile.h"
 
 #include <glm/geometric.hpp>
 
@@ -40,14 +41,27 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         const Vec3 b = branch ? scene.branches[index].tip_cm : scene.bough(index).stripEnd();
         Passage p;
         if (!closestPassage(ray, a, b, p) || !(p.t < tMax + behind)) return true;
-        // The points' lines pass the occluder shifted along its strip by their offsets (scaled
-        // towards a point light), each read with the footprint's own width.
-        const Vec3 n = stripAcross(glm::normalize(b - a), ray.direction);
+        // The points' lines pass the occluder shifted across its strip and along its axis by
+        // their offsets (scaled towards a point light), each read with the footprint's own
+        // width; along the axis where its cones reach (render.occluder_profile "cones").
+        const Vec3 u = glm::normalize(b - a);
+        const Vec3 n = stripAcross(u, ray.direction);
         const Vec3 c = ray.origin + p.t * ray.direction;
         const double gap = reach > 0.0 ? glm::dot(c - (a + p.s * (b - a)), n) : p.gap;
         const double scale = scene.lights[light].directional ? 1.0 : p.t / tMax;
         const double along = glm::dot(at.across, n) * scale;
         const double aside = glm::dot(at.sideways, n) * scale;
+        const TracedBough* profiled =
+            !branch && scene.occludersByCones && scene.bough(index).stripToConesEnd
+                ? &scene.bough(index)
+                : nullptr;
+        const AxialCones cones = profiled ? AxialCones::of(*profiled) : AxialCones{};
+        // A shift d across the light moves a line's passage along the axis by (d . u) / (1 -
+        // (L . u)^2), L the light's direction.
+        const double lu = glm::dot(ray.direction, u);
+        const double perShift = profiled ? scale / std::max(1e-6, 1.0 - lu * lu) : 0.0;
+        const double hAcross = glm::dot(at.across, u) * perShift;
+        const double hSideways = glm::dot(at.sideways, u) * perShift;
         const double w = pointWidth * ray.width(p.t);
         const double R = branch ? scene.branches[index].radius_cm : scene.bough(index).radius_cm;
         // A line farther than this from the axis misses the strip over its footprint: it
@@ -63,8 +77,13 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
                     if (!branch && !fromLight) {
                         fromLight = scene.bough(index).opacityFromLight(light);
                     }
-                    const double alpha = branch ? stripCoverage(g, R, w)
-                                                : fromLight->overFootprint(g, R, w);
+                    double alpha =
+                        branch ? stripCoverage(g, R, w) : fromLight->overFootprint(g, R, w);
+                    if (profiled) {
+                        const double h = p.s * cones.length() + hAcross * q.offset_cm +
+                                         hSideways * q.sideways_cm;
+                        alpha = cones.opacityAt(alpha, h);
+                    }
                     T[k] *= 1.0 - alpha;
                 }
             }

@@ -483,9 +483,21 @@ const Registry<const bool>& needleEnds()
     return open;
 }
 
+// render.occluder_profile: whether a bough seen from a light is read where its cones reach.
+const Registry<const bool>& occluderProfiles()
+{
+    static const Registry<const bool> cones = namedSwitch("occluder profile", "cones", "even");
+    return cones;
+}
+
 }  // namespace
 
 std::vector<std::string> shadowOriginNames() { return shadowOrigins().names(); }
+
+std::vector<std::string> occluderProfileNames()
+{
+    return occluderProfiles().names();
+}
 
 std::vector<std::string> barkNames() { return barks().names(); }
 
@@ -590,6 +602,8 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     const bool solidBark = chosen("bark", [&] { return barks().get(model.bark); });
     const bool openNeedleEnds =
         chosen("needle_ends", [&] { return needleEnds().get(model.needleEnds); });
+    const bool occludersByCones =
+        chosen("occluder_profile", [&] { return occluderProfiles().get(model.occluderProfile); });
     const BoughLawNeeds needs = BoughLawNeeds::from(EffectsPlan::from(scene.effects));
     TracedScene out;
     out.scene = &scene;
@@ -597,6 +611,7 @@ TracedScene buildTracedScene(const scenes::Scene& scene, const TracedSceneParts&
     out.boughLaw = law;
     out.shadowOrigin = origin;
     out.openNeedleEnds = openNeedleEnds;
+    out.occludersByCones = occludersByCones;
     out.lights = unifiedLights(scene);
     out.trees.resize(scene.trees.size());
     // A scatter's variant is grown once, at its first tree. A copy's boughs and branches are

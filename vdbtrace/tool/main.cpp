@@ -97,7 +97,7 @@ private:
 struct ModelOverrides {
     bool paper = false;
     std::string boughLaw, layerModel, extinctionLaw, shadowOrigin, bark, layerCorrelation,
-        needleEnds;
+        needleEnds, occluderProfile;
     double levelBlend = 0.0;    ///< 0: the scene's
     double coneLevelMax = 0.0;  ///< 0: the scene's
     double pixelSplitQ = -1.0;  ///< < 0: the scene's
@@ -108,7 +108,7 @@ struct ModelOverrides {
                      "Every approximation as the paper prints it (render.preset \"paper\"): "
                      "bough law linear, layer model paper, extinction law layer, shadow origin "
                      "axis, no level blend, bark line, level 3 from q = 1, layer correlation "
-                     "independent, needle ends flat");
+                     "independent, needle ends flat, occluder profile even");
         cmd.add_option("--bough-law", boughLaw, "multiscale level 3's law (render.bough_law)")
             ->check(CLI::IsMember(vdbtrace::boughLawNames()));
         cmd.add_option("--layer-model", layerModel,
@@ -136,6 +136,12 @@ struct ModelOverrides {
                        "and the light's lines through one cone meet the same needles: the hot "
                        "spot) or independent (the paper's; render.layer_correlation)")
             ->check(CLI::IsMember(vdbtrace::layerCorrelationNames()));
+        cmd.add_option("--occluder-profile", occluderProfile,
+                       "multiscale: a bough's opacity from a light along its axis; cones (where "
+                       "its cones' needles reach, so that a chain of short boughs shades as one "
+                       "long bough) or even (the strip's mean all along, the paper's; "
+                       "render.occluder_profile)")
+            ->check(CLI::IsMember(vdbtrace::occluderProfileNames()));
         cmd.add_option("--needle-ends", needleEnds,
                        "geometry: the explicit needles' ends; open (a needle is its side, as "
                        "section 4 shades it and every level models it) or flat (solid "
@@ -166,6 +172,7 @@ struct ModelOverrides {
         if (!bark.empty()) m.bark = bark;
         if (!layerCorrelation.empty()) m.layerCorrelation = layerCorrelation;
         if (!needleEnds.empty()) m.needleEnds = needleEnds;
+        if (!occluderProfile.empty()) m.occluderProfile = occluderProfile;
         if (coneLevelMax > 0.0) m.coneLevelMax = coneLevelMax;
         if (pixelSplitQ >= 0.0) m.pixelSplitQ = pixelSplitQ;
         if (!(m.coneLevelMax > render.needleLevelMax)) {
@@ -358,6 +365,7 @@ std::string frameJobDigest(const fs::path& sceneFile, const std::string& methodN
         {"bark", model.bark},
         {"layer_correlation", model.layerCorrelation},
         {"needle_ends", model.needleEnds},
+        {"occluder_profile", model.occluderProfile},
         {"level_blend", model.levelBlend},
         {"pixel_split_q", model.pixelSplitQ},
         {"cone_level_max", model.coneLevelMax},

@@ -118,10 +118,16 @@ struct ModelChoices {
     /// a pixel, the paper's (section 3.2).
     double pixelSplitQ = 0.5;
     static constexpr int kMaxPixelSplit = 4;
+    /// A bough's opacity seen from a light along its axis, where its law's strip runs to the
+    /// cones' end (exact, corrected): "cones" (where its cones' needles reach: a chain's
+    /// neighbours overlap as one long bough) or "even" (the strip's mean all along, section
+    /// 7's one shadow ray through the bough's volume).
+    std::string occluderProfile = "cones";
     /// Every choice as the paper prints it (preset "paper"): today's published behaviour.
     static ModelChoices paper()
     {
-        return {"linear", "paper", "layer", "axis", 1.0, "line", 1.0, "independent", "flat", 0.0};
+        return {"linear", "paper",       "layer", "axis", 1.0,   "line",
+                1.0,      "independent", "flat",  0.0,    "even"};
     }
     /// The choices that agree with the explicit needles (preset "faithful", the default).
     static ModelChoices faithful() { return {}; }
@@ -130,7 +136,7 @@ struct ModelChoices {
 struct RenderSettings {
     Vec3 background{0.55, 0.7, 0.9};
     /// preset, then bough_law, layer_model, extinction_law, shadow_origin, level_blend, bark,
-    /// cone_level_max, layer_correlation, needle_ends, pixel_split_q
+    /// cone_level_max, layer_correlation, needle_ends, pixel_split_q, occluder_profile
     ModelChoices model;
     /// Level thresholds on q = footprint width / cone spacing dh at the hit (the paper chooses
     /// dh = 2 pi R / N, the gap between needle tips, so dh is also the needles' spacing):

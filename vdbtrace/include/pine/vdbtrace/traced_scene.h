@@ -204,6 +204,9 @@ struct TracedScene {
     /// render.needle_ends: whether the explicit needles are their sides alone ("open", what
     /// section 4 shades and every level models) or solid flat-capped cylinders ("flat").
     bool openNeedleEnds = true;
+    /// render.occluder_profile: whether an occluding bough's opacity from a light is read
+    /// where along its axis its cones reach ("cones", occluder_profile.h) or even ("even").
+    bool occludersByCones = true;
 
     /// Made with bvh (indexPrimitives): see columns().
     std::shared_ptr<LightColumnsSet> lightColumns;
@@ -244,6 +247,9 @@ std::vector<std::string> shadowOriginNames();
 
 /// The values of render.bark, the faithful one first.
 std::vector<std::string> barkNames();
+
+/// The values of render.occluder_profile, the faithful one first.
+std::vector<std::string> occluderProfileNames();
 
 /// The values of render.needle_ends, the faithful one first.
 std::vector<std::string> needleEndNames();
