@@ -345,7 +345,8 @@ TEST(ErrorBudget, EachSwitchMovesOneChoiceAndThePresetMovesAll)
                int(a.extinctionLaw != b.extinctionLaw) + int(a.shadowOrigin != b.shadowOrigin) +
                int(a.levelBlend != b.levelBlend) + int(a.bark != b.bark) +
                int(a.coneLevelMax != b.coneLevelMax) +
-               int(a.layerCorrelation != b.layerCorrelation) + int(a.pixelSplitQ != b.pixelSplitQ);
+               int(a.layerCorrelation != b.layerCorrelation) + int(a.pixelSplitQ != b.pixelSplitQ) +
+               int(a.occluderProfile != b.occluderProfile);
     };
     const std::vector<BudgetSwitch> switches = errorBudgetSwitches(faithful);
     ASSERT_FALSE(switches.empty());
