@@ -5,11 +5,12 @@
 // not even: at h from the base the cones whose needles reach h are those with apexes in
 // [h - l cos(phi), h], so their share of a long bough's rises over the first l cos(phi)
 // (3.9 cm on the paper's fir), holds to the last apex and falls over the cones' reach past it.
-// Read "even", each short bough of a chain (a fir's branch is a chain of 6 cm boughs) darkens
-// its neighbours' overlap twice at its mean and its own middle at that mean too: two
-// neighbours let through more than the long bough they make (0.255 of the light from above
-// against the needles' 0.193, bough_shadow_study --segment 6). Read "cones", the opacity at h
-// is 1 - exp(-tau share(h)), tau chosen so that its mean over the strip is the law's: two
+// A fir's branch is a chain of 6 cm boughs, each reaching 3.9 cm over the next. Read "even",
+// at each bough's mean, two neighbours compose as independent strips where they overlap and
+// one strip lies alone between: an optical depth uneven along the chain, which lets through
+// more than the long bough's even one (0.255 of the light from above against the needles'
+// 0.185, FaithfulModels.AChainsShadowIsWhereItsNeedlesCastIt). Read "cones", the opacity at
+// h is 1 - exp(-tau share(h)), tau chosen so that its mean over the strip is the law's:
 // neighbours' shares add up to a long bough's, and their optical depths to its tau.
 #pragma once
 
