@@ -718,7 +718,7 @@ TEST(FaithfulModels, AChainsShadowIsWhereItsNeedlesCastIt)
     // "cones") the chain lets through what its needles let through; read even at each bough's
     // mean, the neighbours' overlaps compose as two independent strips and the rest at the
     // mean, and from above it lets through about a third more. Measured 2026-12-07 against
-    // the needles' 0.186 from above and 0.498 from behind (8 rolls and phases): level 1 0.187
+    // the needles' 0.185 from above and 0.499 from behind (8 rolls and phases): level 1 0.187
     // and 0.478, level 2 0.176 and 0.465; even, level 1 0.255 and 0.523.
     for (const std::string towards : {"0, 0, 1", "0.5, 0.3, 1"}) {
         const double through = needlesShadow(towards, 16, false, "320, 240", 6.0).through;
