@@ -51,15 +51,16 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         const double scale = scene.lights[light].directional ? 1.0 : p.t / tMax;
         const double along = glm::dot(at.across, n) * scale;
         const double aside = glm::dot(at.sideways, n) * scale;
+        // A shift d across the light moves a line's passage along the axis by (d . u) / (1 -
+        // (L . u)^2), L the light's direction. A light within 0.06 degrees of the axis has no
+        // passage to speak of: the line runs along the whole bough, which it reads even.
+        const double lu = glm::dot(ray.direction, u), sin2 = 1.0 - lu * lu;
         const TracedBough* profiled =
-            !branch && scene.occludersByCones && scene.bough(index).stripToConesEnd
+            !branch && scene.occludersByCones && scene.bough(index).stripToConesEnd && sin2 > 1e-6
                 ? &scene.bough(index)
                 : nullptr;
         const AxialCones cones = profiled ? AxialCones::of(*profiled) : AxialCones{};
-        // A shift d across the light moves a line's passage along the axis by (d . u) / (1 -
-        // (L . u)^2), L the light's direction.
-        const double lu = glm::dot(ray.direction, u);
-        const double perShift = profiled ? scale / std::max(1e-6, 1.0 - lu * lu) : 0.0;
+        const double perShift = profiled ? scale / sin2 : 0.0;
         const double hAcross = glm::dot(at.across, u) * perShift;
         const double hSideways = glm::dot(at.sideways, u) * perShift;
         const double w = pointWidth * ray.width(p.t);

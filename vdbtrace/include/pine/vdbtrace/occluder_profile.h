@@ -19,7 +19,9 @@
 namespace pine::vdbtrace {
 
 /// A bough's cones along its axis: apexes over `apexes_cm` from the base, each cone's needles
-/// reaching `reach_cm` (l cos(phi)) past its apex along the axis.
+/// reaching `reach_cm` (l cos(phi)) past its apex along the axis. The apexes are taken as even
+/// over the bough's length; its last one lies up to a cone spacing short of the tip, which
+/// the law's mean (and so tau) takes in. Either length 0: an even strip.
 struct AxialCones {
     double apexes_cm = 0.0, reach_cm = 0.0;
 
@@ -28,6 +30,10 @@ struct AxialCones {
     double length() const { return apexes_cm + reach_cm; }
     /// The largest share(): min(1, apexes / reach).
     double top() const;
+    /// The share of the strip's length where share() is top().
+    double flatShare() const;
+    /// Whether either length is 0: the strip is read even.
+    bool even() const;
     /// The share of a long bough's cones whose needles reach h (cm from the base along the
     /// axis): 0 outside [0, length()], at most min(1, apexes / reach).
     double share(double h_cm) const;
