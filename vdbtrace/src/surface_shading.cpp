@@ -55,11 +55,9 @@ double shadowConeTransmittance(const TracedScene& scene, const Vec3& x, std::siz
         // (L . u)^2), L the light's direction. A light within 0.06 degrees of the axis has no
         // passage to speak of: the line runs along the whole bough, which it reads even.
         const double lu = glm::dot(ray.direction, u), sin2 = 1.0 - lu * lu;
-        const TracedBough* profiled =
-            !branch && scene.occludersByCones && scene.bough(index).stripToConesEnd && sin2 > 1e-6
-                ? &scene.bough(index)
-                : nullptr;
-        const AxialCones cones = profiled ? AxialCones::of(*profiled) : AxialCones{};
+        const bool profiled =
+            !branch && scene.occludersByCones && scene.bough(index).stripToConesEnd && sin2 > 1e-6;
+        const AxialCones cones = profiled ? AxialCones::of(scene.bough(index)) : AxialCones{};
         const double perShift = profiled ? scale / sin2 : 0.0;
         const double hAcross = glm::dot(at.across, u) * perShift;
         const double hSideways = glm::dot(at.sideways, u) * perShift;
