@@ -22,6 +22,13 @@
 // section 6) every band is independent. One long bough lit from 3 degrees off the camera gets
 // 0.84 of the needles' self-shadowed light at level 1 with "independent", 0.98 with "needles"
 // (FaithfulModels.ALoneBoughUnderEveryLight; docs/models.md "Layer correlation").
+//
+// The "arcs" model is the same needles without the bands: each passage of a line near a
+// cone's sheet meets the arc of needle azimuths that cone_arcs.h finds from the needles'
+// geometry, and the passages of one cone share its roll (the union of their arcs), in a
+// line's own layers as in its self-shadowing. Near the axis the bands are 20-50% too opaque
+// (scripts/fibre_middle_study.py); the arcs are what the needles let through on average.
+#include "pine/vdbtrace/cone_arcs.h"
 #include "pine/vdbtrace/cone_crossings.h"
 #include "pine/vdbtrace/layer_model.h"
 
@@ -104,6 +111,8 @@ public:
     {
     }
     const TracedBough& bough() const { return mBough; }
+    const Vec3& e1() const { return mE1; }
+    const Vec3& e2() const { return mE2; }
     // The arc of cone `cone`'s needles a line meets about x, stopped there with
     // probability `opacity` (min(1, n) of its band).
     Arc arc(long cone, const Vec3& x, double opacity, double period) const
@@ -121,13 +130,39 @@ private:
     Vec3 mE1, mE2;
 };
 
+// Calls visit(arc) -> bool (false stops) for the passages of the line from x along d (d unit)
+// through b's cones, the passage of its own cone that x lies in left out (forEachBandFrom).
+template <class Visit>
+void forEachArcFrom(const Azimuths& azimuths, const Vec3& x, const Vec3& d, long ownCone,
+                    Visit&& visit)
+{
+    const TracedBough& b = azimuths.bough();
+    double tIn, tOut;
+    if (!layeredInterval(b, x, d, tIn, tOut)) return;
+    const bool inside = tIn <= 0.0;
+    bool first = true;
+    forEachConeArc(b, x, d, std::max(tIn, 0.0), tOut, azimuths.e1(), azimuths.e2(),
+                   [&](const ConeArc& arc) {
+                       const bool own = first && inside && arc.cone == ownCone;
+                       first = false;
+                       return own || visit(Arc{arc.cone, arc.from, arc.width});
+                   });
+}
+
+// How a line meets a cone's needles: over smeared bands, or over the exact arcs.
+enum class Crossings { Bands, Arcs };
+
 class FibreLayerModel final : public LayerModel {
 public:
-    explicit FibreLayerModel(bool correlated) : mCorrelated(correlated) {}
+    FibreLayerModel(bool correlated, Crossings crossings)
+        : mCorrelated(correlated), mArcs(crossings == Crossings::Arcs)
+    {
+    }
 
     void layers(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn, double tOut,
                 const std::function<bool(const LayerHit&)>& visit) const override
     {
+        if (mArcs) return arcLayers(b, o, d, tIn, tOut, visit);
         forEachConeBand(b, o, d, tIn, tOut, [&](const ConeBand& band) {
             return visit(LayerHit{band.cone, band.t, std::min(1.0, band.needles)});
         });
@@ -138,6 +173,13 @@ public:
     {
         if (mCorrelated && glm::dot(towardsViewer, towardsViewer) > 0.0) {
             return walkedBoth(Azimuths(b), x, towardsLight, ownCone, towardsViewer);
+        }
+        if (mArcs) {  // each cone's passages share its roll
+            thread_local std::vector<Arc> light;
+            const Azimuths azimuths(b);
+            const double period = needlePeriod(b);
+            arcsAlong(azimuths, x, towardsLight, ownCone, period, light);
+            return light.empty() ? 1.0 : conditioned(light, nullptr, 0, period);
         }
         double transmittance = 1.0;
         forEachBandFrom(b, x, towardsLight, ownCone, [&](const ConeBand& band) {
@@ -176,7 +218,7 @@ public:
                           const std::vector<NeedleOnLine>& needles, const Vec3& towardsLight,
                           std::vector<double>& out) const override
     {
-        if (!mCorrelated) {
+        if (!mCorrelated || mArcs) {  // the arcs walk back from each needle
             return LayerModel::transmittancesAt(b, o, d, tIn, tOut, hits, needles, towardsLight,
                                                 out);
         }
@@ -224,10 +266,38 @@ public:
     }
 
 private:
+    // layers() over the arcs: a passage of a cone the line passed before adds what its arc
+    // adds to theirs, so that the product of the layers' transmittances is the cones'.
+    void arcLayers(const TracedBough& b, const Vec3& o, const Vec3& d, double tIn, double tOut,
+                   const std::function<bool(const LayerHit&)>& visit) const
+    {
+        thread_local std::vector<Arc> before, cone;
+        thread_local std::vector<std::pair<double, double>> pieces;
+        before.clear();
+        const Azimuths azimuths(b);
+        const double period = needlePeriod(b);
+        forEachConeArc(b, o, d, tIn, tOut, azimuths.e1(), azimuths.e2(), [&](const ConeArc& a) {
+            const Arc arc{a.cone, a.from, a.width};
+            cone.clear();
+            for (const Arc& e : before) {
+                if (e.cone == a.cone) cone.push_back(e);
+            }
+            double opacity = std::min(1.0, a.width / period);
+            if (!cone.empty()) {
+                const double seen = unionLength(pieces, cone, period);
+                cone.push_back(arc);
+                const double both = unionLength(pieces, cone, period);
+                opacity = seen < period * (1.0 - 1e-9) ? (both - seen) / (period - seen) : 0.0;
+            }
+            before.push_back(arc);
+            return visit(LayerHit{a.cone, a.t, std::clamp(opacity, 0.0, 1.0), a.from, a.width});
+        });
+    }
+
     // The light from `towardsLight` reaching x on a needle of cone `ownCone`, seen from
     // `towardsViewer`: both lines walked from x through the bough's layers.
-    static double walkedBoth(const Azimuths& azimuths, const Vec3& x, const Vec3& towardsLight,
-                             long ownCone, const Vec3& towardsViewer)
+    double walkedBoth(const Azimuths& azimuths, const Vec3& x, const Vec3& towardsLight,
+                      long ownCone, const Vec3& towardsViewer) const
     {
         thread_local std::vector<Arc> light, view;
         const double period = needlePeriod(azimuths.bough());
@@ -247,7 +317,9 @@ private:
         arcsBefore.resize(hits.size());
         for (std::size_t k = 0; k < hits.size(); ++k) {
             arcsBefore[k] = view.size();
-            if (hits[k].opacity > 0.0) {
+            if (hits[k].arcWidth > 0.0) {
+                view.push_back({hits[k].cone, hits[k].arcFrom, hits[k].arcWidth});
+            } else if (hits[k].opacity > 0.0) {
                 view.push_back(
                     azimuths.arc(hits[k].cone, o + hits[k].t * d, hits[k].opacity, period));
             }
@@ -256,8 +328,8 @@ private:
 
     // The light from `towardsLight` reaching x on a needle of cone `ownCone`, seen through the
     // view's `views` arcs from `view`.
-    static double seenThrough(const Azimuths& azimuths, const Vec3& x, const Vec3& towardsLight,
-                              long ownCone, const Arc* view, std::size_t views, double period)
+    double seenThrough(const Azimuths& azimuths, const Vec3& x, const Vec3& towardsLight,
+                       long ownCone, const Arc* view, std::size_t views, double period) const
     {
         thread_local std::vector<Arc> light;
         arcsAlong(azimuths, x, towardsLight, ownCone, period, light);
@@ -270,11 +342,18 @@ private:
         return 2.0 * analytic::kPi / scenes::wholeNeedles(b.geometry.cone.needlesPerCone);
     }
 
-    // The arcs of the line from x along d (forEachBandFrom's bands).
-    static void arcsAlong(const Azimuths& azimuths, const Vec3& x, const Vec3& d, long ownCone,
-                          double period, std::vector<Arc>& out)
+    // The arcs of the line from x along d (forEachArcFrom's, or forEachBandFrom's bands').
+    void arcsAlong(const Azimuths& azimuths, const Vec3& x, const Vec3& d, long ownCone,
+                   double period, std::vector<Arc>& out) const
     {
         out.clear();
+        if (mArcs) {
+            forEachArcFrom(azimuths, x, d, ownCone, [&](const Arc& arc) {
+                if (arc.width > 0.0) out.push_back(arc);
+                return true;
+            });
+            return;
+        }
         forEachBandFrom(azimuths.bough(), x, d, ownCone, [&](const ConeBand& band) {
             if (!(band.needles > 0.0)) return true;
             out.push_back(
@@ -316,14 +395,19 @@ private:
         return transmittance;
     }
 
-    bool mCorrelated;
+    bool mCorrelated, mArcs;
 };
 
 }  // namespace
 
 std::unique_ptr<LayerModel> makeFibreLayerModel(bool correlated)
 {
-    return std::make_unique<FibreLayerModel>(correlated);
+    return std::make_unique<FibreLayerModel>(correlated, Crossings::Bands);
+}
+
+std::unique_ptr<LayerModel> makeArcsLayerModel(bool correlated)
+{
+    return std::make_unique<FibreLayerModel>(correlated, Crossings::Arcs);
 }
 
 }  // namespace pine::vdbtrace

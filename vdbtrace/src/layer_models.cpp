@@ -7,6 +7,7 @@
 
 namespace pine::vdbtrace {
 
+std::unique_ptr<LayerModel> makeArcsLayerModel(bool correlated);
 std::unique_ptr<LayerModel> makeFibreLayerModel(bool correlated);
 std::unique_ptr<LayerModel> makePaperLayerModel();
 
@@ -18,7 +19,8 @@ const Registry<LayerModel>& registry(bool correlated)
 {
     static const auto table = [](bool c) {
         Registry<LayerModel> r("layer model");
-        r.add("fibre", makeFibreLayerModel(c));  // the needles' own statistics (faithful)
+        r.add("fibre", makeFibreLayerModel(c));  // the needles' own statistics, over bands
+        r.add("arcs", makeArcsLayerModel(c));    // ... over each crossing's exact arc
         r.add("paper", makePaperLayerModel());   // constant A whatever the crossing (sec. 3.3)
         return r;
     };

@@ -17,6 +17,11 @@ struct LayerHit {
     long cone = 0;
     double t = 0.0;        ///< along the line: where its needles are met
     double opacity = 0.0;  ///< the probability that the line hits one of them, in [0, 1]
+    /// Where a model knows the needle azimuths that stop the line there (the "arcs" model,
+    /// cone_arcs.h): their arc about the axis, radians in NeedleLayout's frame; width 0 where
+    /// it does not. The arc is the passage's own, before the line's other passages of the
+    /// cone: `opacity` is what it adds to them.
+    double arcFrom = 0.0, arcWidth = 0.0;
 };
 
 class LayerModel {
