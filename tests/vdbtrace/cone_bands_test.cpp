@@ -633,7 +633,7 @@ TEST(ConeArcs, ALineNearTheAxisLetsThroughWhatTheNeedlesDo)
     std::uniform_real_distribution<double> u(0.0, 1.0);
     for (const double g : {0.164, 0.27, 0.5, 0.69, 1.0}) {
         double byNeedles = 0.0, byArcs = 0.0, byBands = 0.0;
-        long lines = 0;
+        int lines = 0;
         for (unsigned seed = 1; seed <= 200; ++seed) {
             TracedBough b = bough;
             b.seed = seed;
@@ -656,8 +656,8 @@ TEST(ConeArcs, ALineNearTheAxisLetsThroughWhatTheNeedlesDo)
                 byNeedles += hit ? 0.0 : 1.0;
                 for (auto [model, sum] : {std::pair{&arcs, &byArcs}, std::pair{&fibre, &byBands}}) {
                     double T = 1.0;
-                    model->layers(b, o, d, tIn, tOut, [&](const LayerHit& hit) {
-                        T *= 1.0 - hit.opacity;
+                    model->layers(b, o, d, tIn, tOut, [&](const LayerHit& layer) {
+                        T *= 1.0 - layer.opacity;
                         return true;
                     });
                     *sum += T;
@@ -670,7 +670,9 @@ TEST(ConeArcs, ALineNearTheAxisLetsThroughWhatTheNeedlesDo)
             "bands %.4f\n",
             g, needles, spread, byArcs / lines, byBands / lines);
         EXPECT_NEAR(byArcs / lines, needles, std::max(0.03 * needles, 3.0 * spread)) << g;
-        if (g < 0.3) EXPECT_LT(byBands / lines, 0.6 * needles) << g;  // what the arcs mend
+        if (g < 0.3) {  // what the arcs mend
+            EXPECT_LT(byBands / lines, 0.6 * needles) << g;
+        }
     }
 }
 
