@@ -366,9 +366,12 @@ TEST(LayerCorrelation, NeedlesAnywhereOnALineReadTheLayersBeforeTheirBand)
             for (std::size_t h = 0; h < hits.size(); ++h) {
                 // Near the layer, of its own cone; every fifth a neighbour's.
                 const long cone = hits[h].cone + (h % 5 == 4 ? 1 : 0);
-                points.push_back({hits[h].t + 0.05 * u(rng), cone});
+                const double t = hits[h].t + 0.05 * u(rng);
+                points.push_back({t, cone, o + t * d});
             }
-            if (!hits.empty()) points.push_back({tOut + 0.02, hits.back().cone});  // beyond it
+            if (!hits.empty()) {  // beyond it
+                points.push_back({tOut + 0.02, hits.back().cone, o + (tOut + 0.02) * d});
+            }
             model.transmittancesAt(b, o, d, tIn, tOut, hits, points, L, at);
             ASSERT_EQ(at.size(), points.size());
             for (std::size_t n = 0; n < points.size(); ++n) {

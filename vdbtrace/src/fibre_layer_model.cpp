@@ -113,6 +113,13 @@ public:
     const TracedBough& bough() const { return mBough; }
     const Vec3& e1() const { return mE1; }
     const Vec3& e2() const { return mE2; }
+    // The azimuth of x about the axis (0 on it).
+    double of(const Vec3& x) const
+    {
+        Vec3 radial;
+        coneHeight(mBough, mCotPhi, x, nullptr, &radial);
+        return std::atan2(glm::dot(radial, mE2), glm::dot(radial, mE1));
+    }
     // The arc of cone `cone`'s needles a line meets about x, stopped there with
     // probability `opacity` (min(1, n) of its band).
     Arc arc(long cone, const Vec3& x, double opacity, double period) const
@@ -130,13 +137,32 @@ private:
     Vec3 mE1, mE2;
 };
 
+// Bits of the neighbours of a needle of cone `ownCone` at x (at x's azimuth psi_x) that the
+// line from x along d (d unit) passes within r of in the passage x lies in: 1 the one at
+// psi_x + P, 2 the one at psi_x - P (P the needle period); 0 where x lies in no passage of it.
+// That cone's roll is known from the needle: a line from a needle near the axis stays within
+// r of its cone's sheet while it sweeps a period, and meets the neighbours that independent
+// rolls would miss (docs/models.md "Crossing arcs").
+int neighboursReached(const Azimuths& azimuths, const ConeArc& own, const Vec3& x, double period)
+{
+    const double twoPi = 2.0 * analytic::kPi;
+    double psi = azimuths.of(x);
+    psi += twoPi * std::round((own.from + 0.5 * own.width - psi) / twoPi);
+    return (own.from + own.width >= psi + period ? 1 : 0) | (own.from <= psi - period ? 2 : 0);
+}
+
 // Calls visit(arc) -> bool (false stops) for the passages of the line from x along d (d unit)
-// through b's cones, the passage of its own cone that x lies in left out (forEachBandFrom).
+// through b's cones but the passage of cone `ownCone` that x, on one of its needles, lies in.
+// That one, with `seen` >= 0 (the light's line, `seen` the neighbours the view's line from x
+// reached), stops the line where it reaches a neighbour the view's line did not (a view that
+// reached one was not of this needle: it says nothing) and is visited as a whole period.
+// `reached`, if given, gets the neighbours the line reached (neighboursReached).
 template <class Visit>
 void forEachArcFrom(const Azimuths& azimuths, const Vec3& x, const Vec3& d, long ownCone,
-                    Visit&& visit)
+                    double period, int seen, Visit&& visit, int* reached = nullptr)
 {
     const TracedBough& b = azimuths.bough();
+    if (reached) *reached = 0;
     double tIn, tOut;
     if (!layeredInterval(b, x, d, tIn, tOut)) return;
     const bool inside = tIn <= 0.0;
@@ -145,7 +171,11 @@ void forEachArcFrom(const Azimuths& azimuths, const Vec3& x, const Vec3& d, long
                    [&](const ConeArc& arc) {
                        const bool own = first && inside && arc.cone == ownCone;
                        first = false;
-                       return own || visit(Arc{arc.cone, arc.from, arc.width});
+                       if (!own) return visit(Arc{arc.cone, arc.from, arc.width});
+                       const int neighbours = neighboursReached(azimuths, arc, x, period);
+                       if (reached) *reached = neighbours;
+                       if (seen < 0 || !(neighbours & ~seen)) return true;
+                       return visit(Arc{arc.cone, arc.from, period});
                    });
 }
 
@@ -178,7 +208,8 @@ public:
             thread_local std::vector<Arc> light;
             const Azimuths azimuths(b);
             const double period = needlePeriod(b);
-            arcsAlong(azimuths, x, towardsLight, ownCone, period, light);
+            const int seen = seenNeighbours(azimuths, x, towardsViewer, ownCone, period);
+            arcsAlong(azimuths, x, towardsLight, ownCone, period, light, seen);
             return light.empty() ? 1.0 : conditioned(light, nullptr, 0, period);
         }
         double transmittance = 1.0;
@@ -203,7 +234,7 @@ public:
         viewArcs(azimuths, o, d, hits, period, view, arcsBefore);
         out.resize(hits.size());
         for (std::size_t k = 0; k < hits.size(); ++k) {
-            out[k] = seenThrough(azimuths, o + hits[k].t * d, towardsLight, hits[k].cone,
+            out[k] = seenThrough(azimuths, o + hits[k].t * d, towardsLight, hits[k].cone, -d,
                                  view.data(), arcsBefore[k], period);
         }
     }
@@ -218,7 +249,14 @@ public:
                           const std::vector<NeedleOnLine>& needles, const Vec3& towardsLight,
                           std::vector<double>& out) const override
     {
-        if (!mCorrelated || mArcs) {  // the arcs walk back from each needle
+        if (mArcs) {  // from each needle's axis, which knows its azimuth
+            out.resize(needles.size());
+            for (std::size_t n = 0; n < needles.size(); ++n) {
+                out[n] = transmittance(b, needles[n].onAxis, towardsLight, needles[n].cone, -d);
+            }
+            return;
+        }
+        if (!mCorrelated) {
             return LayerModel::transmittancesAt(b, o, d, tIn, tOut, hits, needles, towardsLight,
                                                 out);
         }
@@ -260,7 +298,7 @@ public:
                 out[n] = walkedBoth(azimuths, x, towardsLight, needle.cone, -d);
                 continue;
             }
-            out[n] = seenThrough(azimuths, x, towardsLight, needle.cone, view.data(),
+            out[n] = seenThrough(azimuths, x, towardsLight, needle.cone, -d, view.data(),
                                  arcsBefore[own], period);
         }
     }
@@ -301,9 +339,10 @@ private:
     {
         thread_local std::vector<Arc> light, view;
         const double period = needlePeriod(azimuths.bough());
-        arcsAlong(azimuths, x, towardsLight, ownCone, period, light);
+        int seen = 0;
+        arcsAlong(azimuths, x, towardsViewer, ownCone, period, view, -1, &seen);
+        arcsAlong(azimuths, x, towardsLight, ownCone, period, light, seen);
         if (light.empty()) return 1.0;
-        arcsAlong(azimuths, x, towardsViewer, ownCone, period, view);
         return conditioned(light, view.data(), view.size(), period);
     }
 
@@ -326,13 +365,28 @@ private:
         }
     }
 
-    // The light from `towardsLight` reaching x on a needle of cone `ownCone`, seen through the
-    // view's `views` arcs from `view`.
+    // The neighbours of a needle of cone `ownCone` at x that the view's line from x reached
+    // (forEachArcFrom; none for no view, or the bands).
+    int seenNeighbours(const Azimuths& azimuths, const Vec3& x, const Vec3& towardsViewer,
+                       long ownCone, double period) const
+    {
+        int seen = 0;
+        if (!mArcs || !(glm::dot(towardsViewer, towardsViewer) > 0.0)) return seen;
+        forEachArcFrom(
+            azimuths, x, towardsViewer, ownCone, period, -1, [](const Arc&) { return false; },
+            &seen);
+        return seen;
+    }
+
+    // The light from `towardsLight` reaching x on a needle of cone `ownCone`, seen from
+    // `towardsViewer` through the view's `views` arcs from `view`.
     double seenThrough(const Azimuths& azimuths, const Vec3& x, const Vec3& towardsLight,
-                       long ownCone, const Arc* view, std::size_t views, double period) const
+                       long ownCone, const Vec3& towardsViewer, const Arc* view, std::size_t views,
+                       double period) const
     {
         thread_local std::vector<Arc> light;
-        arcsAlong(azimuths, x, towardsLight, ownCone, period, light);
+        const int seen = seenNeighbours(azimuths, x, towardsViewer, ownCone, period);
+        arcsAlong(azimuths, x, towardsLight, ownCone, period, light, seen);
         return light.empty() ? 1.0 : conditioned(light, view, views, period);
     }
 
@@ -343,15 +397,19 @@ private:
     }
 
     // The arcs of the line from x along d (forEachArcFrom's, or forEachBandFrom's bands').
+    // With the arcs, `seen` and `reached` as forEachArcFrom has them.
     void arcsAlong(const Azimuths& azimuths, const Vec3& x, const Vec3& d, long ownCone,
-                   double period, std::vector<Arc>& out) const
+                   double period, std::vector<Arc>& out, int seen = 0, int* reached = nullptr) const
     {
         out.clear();
         if (mArcs) {
-            forEachArcFrom(azimuths, x, d, ownCone, [&](const Arc& arc) {
-                if (arc.width > 0.0) out.push_back(arc);
-                return true;
-            });
+            forEachArcFrom(
+                azimuths, x, d, ownCone, period, seen,
+                [&](const Arc& arc) {
+                    if (arc.width > 0.0) out.push_back(arc);
+                    return true;
+                },
+                reached);
             return;
         }
         forEachBandFrom(azimuths.bough(), x, d, ownCone, [&](const ConeBand& band) {

@@ -119,6 +119,7 @@ private:
         Vec3 needle;
         double t, alpha;
         std::size_t layer = kNoLayer;
+        Vec3 onAxis{0.0};  ///< level 1's: the point of the needle's axis nearest the ray
     };
     static constexpr std::size_t kNoLayer = std::size_t(-1);
     // mLayerHits: bough b's layers along the ray over [tIn, tOut], as the layer model gives them.
@@ -308,7 +309,9 @@ void MultiscaleRayTracer::shadeNeedles(const ConeRay& ray, std::size_t index,
         // Level 1's needles, each seen through the layers the ray met before its band.
         collectLayers(ray, b, tIn, tOut);
         mNeedlesOnRay.clear();
-        for (const NeedleHit& n : mNeedleHits) mNeedlesOnRay.push_back({n.t, n.cone});
+        for (const NeedleHit& n : mNeedleHits) {
+            mNeedlesOnRay.push_back({n.t, n.cone, n.onAxis});
+        }
         for (std::size_t i = 0; i < lights; ++i) {
             mScene.layers->transmittancesAt(b, ray.origin, ray.direction, tIn, tOut, mLayerHits,
                                             mNeedlesOnRay, mLight[i].towards, mLayerLit);
@@ -458,7 +461,7 @@ void MultiscaleRayTracer::addCrossings(const ConeRay& ray, std::size_t index,
             const double c = stripCoverage(p.gap, r, ray.width(p.t));
             if (c <= 0.0) continue;
             ++mStats.needleHits;
-            mNeedleHits.push_back({j, needle, p.t, c});
+            mNeedleHits.push_back({j, needle, p.t, c, kNoLayer, apex + (p.s * l) * needle});
         }
         return true;
     }, /*hiddenInBark=*/false);

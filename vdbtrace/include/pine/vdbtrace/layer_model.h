@@ -56,10 +56,12 @@ public:
     virtual void transmittancesAlong(const TracedBough& b, const Vec3& o, const Vec3& d,
                                      const std::vector<LayerHit>& hits, const Vec3& towardsLight,
                                      std::vector<double>& out) const;
-    /// A needle on a viewing line: where along it, and its cone.
+    /// A needle on a viewing line: where along it, its cone, and the point of its axis nearest
+    /// the line (all of the needle's axis lies at its azimuth, which fixes its cone's roll).
     struct NeedleOnLine {
         double t;
         long cone;
+        Vec3 onAxis;
     };
     /// transmittancesAlong() for needles anywhere on the line o + t d, t in [tIn, tOut] (level
     /// 1's, each found near its cone's sheet), `hits` the line's layers over that span:
