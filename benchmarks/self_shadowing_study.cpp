@@ -52,13 +52,17 @@ int main(int argc, char** argv)
     app.add_option("--correlation", correlation, "The layer model's layer_correlation")
         ->capture_default_str()
         ->check(CLI::IsMember(layerCorrelationNames()));
+    std::string layerModelName = "fibre";
+    app.add_option("--layer-model", layerModelName, "The layer model (render.layer_model)")
+        ->capture_default_str()
+        ->check(CLI::IsMember(layerModelNames()));
     long points = 400000;
     app.add_option("--points", points, "Random points on the needles")
         ->capture_default_str()
         ->check(pine::tool::wholeNumberIn(1000, 100000000));
     return pine::tool::run("self_shadowing_study", app, argc, argv, [&] {
         const Vec3 L = pine::study::lightDirection(light), V(0.0, -1.0, 0.0);
-        const LayerModel& layers = layerModel("fibre", layerCorrelated(correlation));
+        const LayerModel& layers = layerModel(layerModelName, layerCorrelated(correlation));
         // The test's bough: N 12, r 0.05, l 4.25, phi pi/8, dh 0.9, 200 cm along x, seen from -y.
         const pine::scenes::Scene scene = pine::scenes::parseScene(R"({"name": "study",
   "camera": {"position": [0, -400, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 9,
@@ -135,10 +139,10 @@ int main(int argc, char** argv)
             model[bin] += w * layers.transmittance(b, onAxis, L, j, V);
         }
         std::printf(
-            "towards the light (%.3f, %.3f, %.3f), %.1f deg from the view; layer "
+            "towards the light (%.3f, %.3f, %.3f), %.1f deg from the view; layer model %s, "
             "correlation %s; %ld points\n",
             L.x, L.y, L.z, std::acos(std::clamp(glm::dot(L, V), -1.0, 1.0)) * 180.0 / kPi,
-            correlation.c_str(), points);
+            layerModelName.c_str(), correlation.c_str(), points);
         std::printf("%-16s %8s %10s %10s %8s\n", "rho (cm)", "weight", "needles", "model", "ratio");
         double W = 0.0, R = 0.0, M = 0.0;
         for (int k = 0; k < kBins; ++k) {
