@@ -105,7 +105,15 @@ bool coneArc(const TracedBough& b, const ConeLine& line, const Vec3& o, const Ve
     psiNear = psis[bottom];
     const double low = -refined(lower, bottom, -1.0);
     out.cone = j;
-    out.t = ta + step * deepest;
+    // Where the line passes the arc's middle azimuth: its needles' mean position along it.
+    const double middle = 0.5 * (high + low);
+    int nearest = deepest;
+    for (int i = 0; i < kSamples; ++i) {
+        if (depth[i] >= 0.0 && std::abs(psis[i] - middle) < std::abs(psis[nearest] - middle)) {
+            nearest = i;
+        }
+    }
+    out.t = ta + step * nearest;
     out.from = low;
     out.width = std::min(2.0 * kPi, std::max(0.0, high - low));
     return true;
