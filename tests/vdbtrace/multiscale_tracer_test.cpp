@@ -489,7 +489,7 @@ TEST(BoughLaw, UnknownNameIsRefusedWithTheKnownOnes)
     scene.render.model.layerModel = "foam";
     expectInputError([&] { buildTracedScene(scene); },
                      "fir.json: render.layer_model: unknown layer model 'foam' (known: fibre, "
-                     "paper)");
+                     "arcs, paper)");
     EXPECT_EQ(shadowOriginNames().front(), scenes::ModelChoices{}.shadowOrigin);
     scene.render.model = {};
     scene.render.model.shadowOrigin = "sun";
