@@ -124,9 +124,7 @@ public:
     // probability `opacity` (min(1, n) of its band).
     Arc arc(long cone, const Vec3& x, double opacity, double period) const
     {
-        Vec3 radial;
-        coneHeight(mBough, mCotPhi, x, nullptr, &radial);
-        const double azimuth = std::atan2(glm::dot(radial, mE2), glm::dot(radial, mE1));
+        const double azimuth = of(x);
         const double width = opacity * period;
         return {cone, azimuth - 0.5 * width, width};
     }
@@ -339,10 +337,13 @@ private:
     {
         thread_local std::vector<Arc> light, view;
         const double period = needlePeriod(azimuths.bough());
+        // The arcs' light reads the neighbours the view reached; the bands' need no view
+        // where the light meets nothing.
         int seen = 0;
-        arcsAlong(azimuths, x, towardsViewer, ownCone, period, view, -1, &seen);
+        if (mArcs) arcsAlong(azimuths, x, towardsViewer, ownCone, period, view, -1, &seen);
         arcsAlong(azimuths, x, towardsLight, ownCone, period, light, seen);
         if (light.empty()) return 1.0;
+        if (!mArcs) arcsAlong(azimuths, x, towardsViewer, ownCone, period, view);
         return conditioned(light, view.data(), view.size(), period);
     }
 

@@ -33,13 +33,13 @@ namespace pine::vdbtrace {
 /// the cone is surely hit.
 struct ConeArc {
     long cone = 0;
-    double t = 0.0;  ///< where the passage comes nearest the needles' axes (the crossing)
+    double t = 0.0;  ///< where the line passes the arc's middle azimuth (its needles' mean)
     double from = 0.0, width = 0.0;
 };
 
 /// The arc of cone j's needles the line meets over the passage t in [ta, tb] (ConeArc), from
-/// `samples` points evenly over it, the extremes refined by a parabola through their
-/// neighbours. False if no point of it lies within r of a needle.
+/// points evenly over it, each extreme refined by a golden-section search between its best
+/// point's neighbours (cone_arcs.cpp). False if no point of it lies within r of a needle.
 bool coneArc(const TracedBough& b, const ConeLine& line, const Vec3& o, const Vec3& d,
              const Vec3& e1, const Vec3& e2, long j, double ta, double tb, ConeArc& out);
 
